@@ -1,0 +1,20 @@
+"""Run one composed config: build the context and the job, run it, always release the robot."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+from omegaconf import DictConfig
+
+from emopose.build import build_context, build_job
+
+log = logging.getLogger(__name__)
+
+
+def run(cfg: DictConfig, run_dir: str | Path) -> dict:
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    job = build_job(cfg)
+    with build_context(cfg, run_dir) as ctx:
+        return job(ctx)

@@ -1,0 +1,1 @@
+"""Execution backends: one class per file, one YAML per backend under conf/backend/."""

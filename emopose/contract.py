@@ -1,0 +1,106 @@
+"""The semantic contract: what a planner may say (records, plans) and what the robot owns (library entries).
+
+Values that cross the model boundary are pydantic models validated once, where they enter.
+The model never supplies a joint value: `LibraryEntry.keyframes` only ever come from library files.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
+
+from emopose import CLASSES, NUM_JOINTS
+
+GestureClass = Literal[
+    "pointing", "emphasizing", "rejecting", "agreeing", "doubting", "welcoming", "comforting", "neutral"
+]
+PlanSource = Literal["model", "plain_text", "keyword_fallback", "empty"]
+
+MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
+
+
+class GestureRecord(BaseModel):
+    """One semantic record z_k = (class, variant, intensity, trigger, confidence) (paper Eq. record)."""
+
+    model_config = ConfigDict(frozen=True, populate_by_name=True)
+
+    cls: GestureClass = Field(alias="class")
+    variant: str | None = None
+    intensity: int = Field(default=3, ge=1, le=5)
+    trigger: str | None = None
+    confidence: float = Field(default=1.0, ge=0.0, le=1.0)
+
+    def as_json(self) -> dict:
+        return self.model_dump(by_alias=True)
+
+
+class Plan(BaseModel):
+    """A verbal reply and its ordered gesture records, plus how the parser obtained them."""
+
+    model_config = ConfigDict(frozen=True)
+
+    reply: str
+    records: tuple[GestureRecord, ...]
+    source: PlanSource = "model"
+    notes: tuple[str, ...] = ()
+
+    @property
+    def top_class(self) -> str:
+        return self.records[0].cls if self.records else "neutral"
+
+
+MotionType = Literal["sequence", "pose"]
+
+
+class LibraryEntry(BaseModel):
+    """One robot-owned motion l_n = (name, class, keyframes Q, duration d, motion type m) (paper Eq. library)."""
+
+    model_config = ConfigDict(frozen=True, populate_by_name=True, extra="forbid")
+
+    name: str = Field(pattern=r"^[a-z][a-z0-9_]{1,63}$")
+    cls: GestureClass = Field(alias="class")
+    description: str = Field(min_length=3, max_length=200)
+    motion_type: MotionType = "sequence"
+    duration: float | None = Field(default=None, gt=0.0, le=20.0)
+    keyframes: tuple[tuple[float, ...], ...]
+    _q: np.ndarray = PrivateAttr()
+
+    @field_validator("keyframes")
+    @classmethod
+    def _shape(cls, frames: tuple[tuple[float, ...], ...]) -> tuple[tuple[float, ...], ...]:
+        for k, frame in enumerate(frames):
+            if len(frame) != NUM_JOINTS:
+                raise ValueError(f"keyframe {k} has {len(frame)} values; every keyframe needs {NUM_JOINTS}")
+            if not all(np.isfinite(frame)):
+                raise ValueError(f"keyframe {k} contains a non-finite value")
+        return frames
+
+    @model_validator(mode="after")
+    def _count(self) -> LibraryEntry:
+        k = len(self.keyframes)
+        if self.motion_type == "pose" and k != 1:
+            raise ValueError(f"a pose has exactly 1 keyframe, got {k}")
+        if self.motion_type == "sequence" and not MIN_KEYFRAMES <= k <= MAX_KEYFRAMES:
+            raise ValueError(
+                f"a sequence needs {MIN_KEYFRAMES}..{MAX_KEYFRAMES} keyframes (at least one interior), got {k}"
+            )
+        self._q = np.asarray(self.keyframes, dtype=float)
+        self._q.setflags(write=False)
+        return self
+
+    @property
+    def q(self) -> np.ndarray:
+        """Keyframes as a read-only (K, 14) array in radians."""
+        return self._q
+
+    @property
+    def default_duration(self) -> float:
+        """Paper Eq. duration: d(Q) = clip(0.3 (K - 1), 1, 5) s, unless the entry sets one explicitly."""
+        if self.duration is not None:
+            return self.duration
+        return float(np.clip(0.3 * (len(self.keyframes) - 1), 1.0, 5.0))
+
+
+assert tuple(GestureClass.__args__) == CLASSES  # one list of classes, in the paper's order

@@ -1,0 +1,1 @@
+"""Semantic planners: one file per family, one YAML per option under conf/planner/."""

@@ -1,0 +1,68 @@
+"""What every planner offers: a request in, raw contract text out (the parse stage makes it a Plan).
+
+Planners own the protocol with their model (a chat prompt, a label-only question, a classifier), but
+always answer in the contract's JSON: {"reply": str, "gestures": [{"class", "variant", "intensity",
+"trigger", "confidence"}, ...]}. That keeps one parser, one validation edge, and one place that can fail.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """An utterance to plan gestures for, with optional dialogue history and an optional image.
+
+    history: [{"role": "user" | "assistant", "content": str}, ...], oldest first.
+    image: a path to an image file, raw PNG/JPEG bytes, or None.
+    """
+
+    utterance: str
+    history: tuple[dict, ...] = ()
+    image: str | bytes | None = None
+
+
+@dataclass(frozen=True)
+class PlannerOutput:
+    """The planner's raw answer in contract JSON, its latency, and whether it is a fallback answer."""
+
+    raw: str
+    latency_s: float = 0.0
+    fallback: bool = False
+    error: str | None = None
+    meta: dict = field(default_factory=dict)
+
+
+@runtime_checkable
+class Planner(Protocol):
+    name: str
+
+    def plan(self, request: PlanRequest) -> PlannerOutput: ...
+
+
+def plan_all(planner: Planner, requests: Sequence[PlanRequest]) -> list[PlannerOutput]:
+    """Plan many requests; planners with a concurrent `plan_many` use it (LLM calls), others loop."""
+    batch = getattr(planner, "plan_many", None)
+    if batch is not None:
+        return list(batch(requests))
+    return [planner.plan(r) for r in requests]
+
+
+@dataclass
+class _Stopwatch:
+    start: float
+    elapsed: float = 0.0
+
+
+@contextmanager
+def timed() -> Iterator[_Stopwatch]:
+    watch = _Stopwatch(time.perf_counter())
+    try:
+        yield watch
+    finally:
+        watch.elapsed = time.perf_counter() - watch.start

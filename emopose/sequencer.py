@@ -1,0 +1,206 @@
+"""The robot-side gesture sequencer (paper Fig. sequencer): one active trajectory, a FIFO queue.
+
+IDLE/HOLDING --released command--> EXECUTING (trajectory built from the latest published pose)
+EXECUTING --done, successor released--> BLENDING (cubic, <= blend_s) --> EXECUTING
+EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> BLENDING to neutral
+                                                (recover_s) --> IDLE
+any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
+
+`step(now)` is called once per 50 Hz tick and returns the 14-DoF target to publish; every transition
+starts from the latest published pose, so the stream never jumps. submit/interrupt are thread-safe.
+Time is whatever `now` the caller passes: tests drive it with a fake clock.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from enum import Enum
+
+import numpy as np
+
+from emopose.trajectory import Trajectory, TrajectoryBuilder
+
+
+class State(str, Enum):
+    IDLE = "idle"
+    EXECUTING = "executing"
+    HOLDING = "holding"
+    BLENDING = "blending"
+
+
+@dataclass(frozen=True)
+class GestureCommand:
+    """A motion to run: intensity-modulated (K, 14) keyframes, duration, earliest start (clock time)."""
+
+    name: str
+    keyframes: np.ndarray
+    duration: float
+    release_at: float = float("-inf")
+    label: str = ""
+    id: int = field(default_factory=itertools.count().__next__)
+
+
+@dataclass(frozen=True)
+class Event:
+    t: float
+    kind: str  # started, completed, stopped, rejected, state
+    name: str = ""
+    command_id: int | None = None
+    detail: str = ""
+
+
+SafetyCheck = Callable[[np.ndarray], "str | None"]
+
+
+class Sequencer:
+    def __init__(
+        self,
+        builder: TrajectoryBuilder,
+        neutral: np.ndarray,
+        safety: SafetyCheck | None = None,
+        blend_s: float = 0.3,
+        hold_s: float = 2.0,
+        recover_s: float = 1.0,
+        interrupt_blend_s: float = 0.3,
+        neutral_tolerance: float = 0.02,
+        on_event: Callable[[Event], None] | None = None,
+    ) -> None:
+        self.builder = builder
+        self.neutral = np.asarray(neutral, dtype=float)
+        self.safety = safety
+        self.blend_s, self.hold_s, self.recover_s = blend_s, hold_s, recover_s
+        self.interrupt_blend_s = interrupt_blend_s
+        self.neutral_tolerance = neutral_tolerance
+        self.on_event = on_event
+        self.events: list[Event] = []
+        self.construction_s: list[float] = []
+        self._lock = threading.RLock()
+        self._queue: deque[GestureCommand] = deque()
+        self.reset(self.neutral, 0.0)
+
+    # -- public, thread-safe -------------------------------------------------------------------
+    def reset(self, q0: np.ndarray, now: float) -> None:
+        with self._lock:
+            self.last = np.array(q0, dtype=float)
+            self.state = State.IDLE
+            self._queue.clear()
+            self._motion: Trajectory | None = None
+            self._index = 0
+            self._active: GestureCommand | None = None
+            self._after_blend: GestureCommand | None = None
+            self._hold_since = now
+
+    def submit(self, command: GestureCommand) -> None:
+        with self._lock:
+            self._queue.append(command)
+
+    def interrupt(self, commands: list[GestureCommand] | tuple = (), now: float | None = None) -> None:
+        """Clear pending actions; blend from the latest published pose to the first new command (or neutral)."""
+        with self._lock:
+            now = self._hold_since if now is None else now
+            if self._active is not None:
+                self._emit(now, "stopped", self._active)
+            self._queue.clear()
+            self._queue.extend(commands[1:])
+            if commands:
+                first = commands[0]
+                self._start_blend(now, np.asarray(first.keyframes[0]), self.interrupt_blend_s, first)
+            else:
+                self._start_blend(now, self.neutral, self.recover_s, None)
+
+    @property
+    def pending(self) -> list[GestureCommand]:
+        with self._lock:
+            return list(self._queue)
+
+    @property
+    def active(self) -> GestureCommand | None:
+        return self._active
+
+    def settled(self) -> bool:
+        """Nothing running and nothing queued (HOLDING or IDLE)."""
+        with self._lock:
+            return self.state in (State.IDLE, State.HOLDING) and not self._queue
+
+    # -- the tick ------------------------------------------------------------------------------
+    def step(self, now: float) -> np.ndarray:
+        with self._lock:
+            if self.state in (State.EXECUTING, State.BLENDING):
+                self._advance(now)
+            if self.state in (State.IDLE, State.HOLDING) or self._recovering():
+                self._maybe_start(now)
+            if self.state == State.HOLDING and now - self._hold_since >= self.hold_s:
+                self._recover(now)
+            return self.last.copy()
+
+    # -- internals (lock held) -----------------------------------------------------------------
+    def _advance(self, now: float) -> None:
+        self._index += 1
+        self.last = self._motion.samples[self._index].copy()
+        if self._index < len(self._motion.samples) - 1:
+            return
+        if self.state == State.EXECUTING:
+            self._emit(now, "completed", self._active)
+            self._active = None
+            head = self._queue[0] if self._queue else None
+            if head is not None and head.release_at <= now:
+                self._queue.popleft()
+                self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
+            else:
+                self._set_state(now, State.HOLDING)
+        elif self._after_blend is not None:
+            command, self._after_blend = self._after_blend, None
+            if not self._begin(command, now):
+                self._set_state(now, State.HOLDING)
+        else:
+            self._set_state(now, State.IDLE)
+
+    def _recovering(self) -> bool:
+        return self.state == State.BLENDING and self._after_blend is None and self._active is None
+
+    def _maybe_start(self, now: float) -> None:
+        while self._queue and self._queue[0].release_at <= now:
+            if self._begin(self._queue.popleft(), now):
+                return
+
+    def _begin(self, command: GestureCommand, now: float) -> bool:
+        started = time.perf_counter()
+        motion = self.builder.build(command.keyframes, command.duration, self.last)
+        self.construction_s.append(time.perf_counter() - started)
+        reason = self.safety(motion.samples) if self.safety else None
+        if reason is not None:
+            self._emit(now, "rejected", command, reason)
+            return False
+        self._motion, self._index, self._active = motion, 0, command
+        self._set_state(now, State.EXECUTING)
+        self._emit(now, "started", command, f"stretch={motion.stretch:.2f}" if motion.stretch > 1 else "")
+        return True
+
+    def _start_blend(self, now: float, target: np.ndarray, duration: float, then: GestureCommand | None) -> None:
+        self._motion = self.builder.blend(self.last, target, duration)
+        self._index, self._active, self._after_blend = 0, None, then
+        self._set_state(now, State.BLENDING)
+
+    def _recover(self, now: float) -> None:
+        if np.max(np.abs(self.last - self.neutral)) <= self.neutral_tolerance:
+            self._set_state(now, State.IDLE)
+        else:
+            self._start_blend(now, self.neutral, self.recover_s, None)
+
+    def _set_state(self, now: float, state: State) -> None:
+        if state == State.HOLDING:
+            self._hold_since = now
+        if state != self.state:
+            self.state = state
+            self._emit(now, "state", None, state.value)
+
+    def _emit(self, now: float, kind: str, command: GestureCommand | None, detail: str = "") -> None:
+        event = Event(now, kind, command.name if command else "", command.id if command else None, detail)
+        self.events.append(event)
+        if self.on_event is not None:
+            self.on_event(event)

@@ -1,0 +1,1 @@
+"""Speech: synthesis with word timings (espeak-ng), optional hosted TTS/ASR, playback."""

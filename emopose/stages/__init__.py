@@ -1,0 +1,1 @@
+"""The six pipeline stages: parse, resolve, modulate, schedule, sequence, dispatch (conf/pipeline/)."""

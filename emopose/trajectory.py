@@ -1,0 +1,101 @@
+"""Trajectory construction G (Eq. smoothstep) and the cubic blend (Eq. blend).
+
+G: the keyframe path q_last -> q~_1 -> ... -> q~_{K-1} (the first segment starts at the latest
+published pose in place of q~_0, so the initial transition is embedded and the duration stays d) is
+cut into M = 5 smoothstep increments per segment, w_{k,r} = q_{k-1} + s(r/M)(q_k - q_{k-1}) with
+s(u) = 3u^2 - 2u^3, then linearly resampled at 50 Hz and projected into the hard limits.
+A pose (one keyframe) is a single segment from q_last to the pose.
+
+Beyond the paper: if a sample step would exceed the joint speed bound (for example an intensity-5
+excursion, or a start far from the first keyframe), the whole trajectory is slowed down uniformly
+until it does not; `stretch` reports the factor. Blends get the same treatment.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from emopose import CONTROL_DT
+from emopose.library import JointLimits
+
+SMOOTHSTEP_INCREMENTS = 5
+
+
+def smoothstep(u: np.ndarray | float) -> np.ndarray | float:
+    return 3 * u**2 - 2 * u**3
+
+
+def blend_weight(u: np.ndarray) -> np.ndarray:
+    """beta(u) of Eq. blend: 4u^3 for u < 1/2, else 1 - (-2u + 2)^3 / 2."""
+    return np.where(u < 0.5, 4 * u**3, 1 - 0.5 * (2 - 2 * u) ** 3)
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """(N + 1, 14) samples at t = n * dt; samples[0] is the pose it starts from, samples[-1] its end."""
+
+    samples: np.ndarray
+    dt: float
+    stretch: float = 1.0
+
+    @property
+    def duration(self) -> float:
+        return (len(self.samples) - 1) * self.dt
+
+
+class TrajectoryBuilder:
+    """Builds G(entry keyframes, intensity-modulated, q_last) and blends, within limits and speed bounds."""
+
+    def __init__(self, limits: JointLimits, dt: float = CONTROL_DT, increments: int = SMOOTHSTEP_INCREMENTS):
+        self.limits = limits
+        self.dt = dt
+        self.increments = increments
+        self._s = smoothstep(np.arange(1, increments + 1) / increments)[None, :, None]
+
+    def waypoints(self, keyframes: np.ndarray, q_last: np.ndarray) -> np.ndarray:
+        """Eq. smoothstep waypoints, (segments * M + 1, 14), starting at q_last."""
+        anchors = np.array(keyframes, dtype=float, ndmin=2)
+        anchors = np.vstack([q_last, anchors]) if len(anchors) == 1 else np.vstack([q_last, anchors[1:]])
+        start, delta = anchors[:-1, None, :], np.diff(anchors, axis=0)[:, None, :]
+        inner = (start + self._s * delta).reshape(-1, anchors.shape[1])
+        return np.vstack([q_last, inner])
+
+    def resample(self, waypoints: np.ndarray, duration: float) -> np.ndarray:
+        """Linear resampling of uniformly timed waypoints at dt; the last sample is the last waypoint."""
+        n = max(1, math.ceil(duration / self.dt - 1e-9))
+        x = np.minimum(np.arange(n + 1) * self.dt, duration) * ((len(waypoints) - 1) / duration)
+        i0 = np.minimum(x.astype(int), len(waypoints) - 2)
+        frac = (x - i0)[:, None]
+        return waypoints[i0] + frac * (waypoints[i0 + 1] - waypoints[i0])
+
+    def build(self, keyframes: np.ndarray, duration: float, q_last: np.ndarray) -> Trajectory:
+        q_last = np.asarray(q_last, dtype=float)
+        waypoints = self.waypoints(keyframes, q_last)
+        stretch = self._overspeed(waypoints, duration)
+        samples = self.limits.project(self.resample(waypoints, duration * stretch))
+        samples[0] = q_last
+        return Trajectory(samples, self.dt, stretch)
+
+    def blend(self, q_from: np.ndarray, q_to: np.ndarray, duration: float) -> Trajectory:
+        """Eq. blend from q_from to q_to; lengthened only if `duration` would break the speed bound."""
+        q_from, q_to = np.asarray(q_from, dtype=float), np.asarray(q_to, dtype=float)
+        # beta' peaks at 3 (u = 1/2), so the fastest joint moves 3 |dq| / T.
+        needed = float(np.max(3 * np.abs(q_to - q_from) / self.limits.max_velocity))
+        length = max(duration, needed, self.dt)
+        n = max(1, math.ceil(length / self.dt - 1e-9))
+        u = np.arange(n + 1) / n
+        samples = self.limits.project(q_from + blend_weight(u)[:, None] * (q_to - q_from))
+        samples[0] = q_from
+        return Trajectory(samples, self.dt, length / duration if duration > 0 else 1.0)
+
+    def _overspeed(self, waypoints: np.ndarray, duration: float) -> float:
+        """Slow-down factor so the steepest waypoint segment respects the speed bound (1.0 if it does).
+
+        Linear resampling never steps faster than the steepest segment between waypoints, so bounding
+        the waypoint slopes bounds every 50 Hz step."""
+        spacing = duration / (len(waypoints) - 1)
+        ratio = float(np.max(np.abs(np.diff(waypoints, axis=0)) / (self.limits.max_velocity * spacing)))
+        return ratio * 1.001 if ratio > 1.0 else 1.0

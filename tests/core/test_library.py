@@ -1,0 +1,55 @@
+import pytest
+import yaml
+
+from emopose.library import LibraryError
+from tests.conftest import REST, load_library, make_library_dir, write_motion
+
+
+def test_guide_version_bumps_on_save_and_new_variant_resolves(writable_library):
+    version = writable_library.version
+    data = {"name": "my_new_wave", "class": "welcoming", "description": "a new wave",
+            "keyframes": [REST, [v + 0.2 for v in REST], REST]}
+    writable_library.save(data)
+    assert writable_library.version == version + 1 and writable_library.get("my_new_wave").cls == "welcoming"
+
+
+def test_save_is_atomic_and_keeps_a_backup(writable_library):
+    data = {"name": "agreeing_a", "class": "agreeing", "description": "edited", "keyframes": [REST] * 3}
+    writable_library.save(data)
+    folder = writable_library.write_dir
+    assert yaml.safe_load((folder / "agreeing_a.yaml").read_text())["description"] == "edited"
+    assert list((folder / ".backup").glob("agreeing_a.v*.yaml"))
+    assert not list(folder.glob(".*.tmp"))
+
+
+@pytest.mark.parametrize("mutation,needle", [
+    (lambda d: d.update(keyframes=[REST[:13]] * 3), "keyframe 0 has 13 values"),
+    (lambda d: d.update(keyframes=[REST] * 2), "3..14 keyframes"),
+    (lambda d: d.update({"class": "dancing"}), "class"),
+    (lambda d: d.update(keyframes=[REST, [9.0] * 14, REST]), "leave the joint limits"),
+    (lambda d: d.update(extra_field=1), "extra_field"),
+])
+def test_broken_file_names_file_entry_and_field(tmp_path, mutation, needle):
+    folder = make_library_dir(tmp_path / "lib")
+    data = {"name": "broken_one", "class": "agreeing", "description": "broken", "keyframes": [REST] * 3}
+    mutation(data)
+    write_motion(folder, "broken_one", data.pop("class"), data.pop("keyframes"),
+                 **{k: v for k, v in data.items() if k not in ("name", "description")})
+    with pytest.raises(LibraryError) as info:
+        load_library(folder)
+    assert "broken_one.yaml" in str(info.value) and needle in str(info.value)
+
+
+def test_unreadable_yaml_and_duplicate_names(tmp_path):
+    folder = make_library_dir(tmp_path / "lib")
+    (folder / "zz.yaml").write_text("name: [unclosed")
+    with pytest.raises(LibraryError, match="zz.yaml: not readable YAML"):
+        load_library(folder)
+    (folder / "zz.yaml").write_text((folder / "agreeing_a.yaml").read_text())
+    with pytest.raises(LibraryError, match="already defined"):
+        load_library(folder)
+
+
+def test_duration_rule(library):
+    assert library.get("agreeing_a").default_duration == 1.0  # clip(0.3 * 3, 1, 5)
+    assert library.get("agreeing_b").default_duration == 1.5  # explicit
