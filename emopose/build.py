@@ -29,8 +29,13 @@ def make(node: Any, key: str, **kwargs: Any) -> Any:
     if node is None or (isinstance(node, DictConfig) and "_target_" not in node):
         return None
     try:
-        return instantiate(node, _convert_="all", **kwargs)
-    except InstantiationException as exc:
+        if not kwargs:
+            return instantiate(node, _convert_="all")
+        # Runtime objects go straight to the factory: instantiate(node, **kwargs) would merge them into the
+        # config, and OmegaConf turns a dataclass instance (MotionLibrary, TrajectoryBuilder) into a config node.
+        factory = instantiate(node, _convert_="all", _partial_=True)
+        return factory(**kwargs)
+    except (InstantiationException, TypeError) as exc:
         cause = exc.__cause__ or exc
         raise ConfigError(f"cannot build '{key}' ({OmegaConf.select(node, '_target_')}): {cause}") from exc
 
@@ -59,8 +64,9 @@ def build_context(cfg: DictConfig, run_dir: str | Path) -> RunContext:
                      safety=safety_check(make(cfg.safety, "safety")))
     speech = make(cfg.tts, "tts")
     player = make(cfg.get("player"), "player")
+    thinking = make(cfg.get("thinking"), "thinking", library=library)
     return RunContext(library=library, planner=planner, pipeline=Pipeline(stages), backend=backend,
-                      sequencer=sequencer, clock=clock, speech=speech, player=player,
+                      sequencer=sequencer, clock=clock, speech=speech, player=player, thinking=thinking,
                       run_dir=Path(run_dir), record=bool(cfg.run.record))
 
 

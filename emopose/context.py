@@ -9,6 +9,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -39,6 +40,8 @@ class RunContext:
     run_dir: Path
     record: bool = True
     player: object | None = None
+    thinking: object | None = None  # emopose.thinking.ThinkingGesture: masks planner latency
+    scene: object | None = None  # emopose.tour.scene_view.SceneView: what pointing can aim at (tour)
     recorder: Recorder | None = None
     loop: ControlLoop | None = None
     history: list[dict] = field(default_factory=list)
@@ -96,11 +99,19 @@ class RunContext:
         """Plan and execute one utterance through the whole pipeline, and log it to history and MCAP."""
         self.open()
         turn = self.new_turn(utterance, image)
+        self.plan_turn(turn)
         self.pipeline.run(turn, self, self.planner)
         self.history.extend([{"role": "user", "content": utterance},
                              {"role": "assistant", "content": turn.plan.reply}])
         self.record_turn(turn)
         return turn
+
+    def plan_turn(self, turn: Turn) -> None:
+        """The planner call, wrapped in the optional thinking gesture that masks its latency."""
+        masking = self.thinking.around_planning(self) if self.thinking is not None else nullcontext()
+        with masking:
+            turn.planner_output = self.planner.plan(turn.request)
+        turn.stage_s["planner"] = turn.planner_output.latency_s
 
     def record_turn(self, turn: Turn) -> None:
         if self.recorder is None or self.loop is None:

@@ -1,0 +1,81 @@
+"""Speech recognition for the user's side of a turn: asr=none (typed text) or asr=litellm (any model).
+
+Both offer `utterance(text=None, audio=None) -> str`: typed text passes through unchanged; an audio file
+is transcribed (asr=litellm) or refused with the fix (asr=none). litellm.transcription posts the file
+to `{api_base}/audio/transcriptions` (OpenAI-compatible servers, whisper.cpp, vLLM, hosted providers).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+log = logging.getLogger(__name__)
+
+AUDIO_SUFFIXES = (".wav", ".mp3", ".m4a", ".ogg", ".oga", ".flac", ".webm", ".mp4", ".mpeg", ".mpga")
+
+
+class ASRError(RuntimeError):
+    """An utterance could not be obtained; the message names the config key or file to fix."""
+
+
+class Recognizer:
+    name = "base"
+
+    def utterance(self, text: str | None = None, audio: str | Path | None = None) -> str:
+        """Typed text wins; otherwise the transcript of `audio`."""
+        if text is not None and text.strip():
+            return text.strip()
+        if audio is None:
+            raise ASRError("no utterance: give typed text or an audio file")
+        return self.transcribe(audio)
+
+    def transcribe(self, audio: str | Path) -> str:
+        raise NotImplementedError
+
+
+class TypedText(Recognizer):
+    """asr=none: the user types; audio input is refused with the way to enable it."""
+
+    name = "none"
+
+    def transcribe(self, audio: str | Path) -> str:
+        raise ASRError(f"asr=none cannot transcribe {audio}: type the utterance, or run with asr=litellm")
+
+
+class LitellmTranscriber(Recognizer):
+    """asr=litellm: litellm.transcription against any model and endpoint."""
+
+    name = "litellm"
+
+    def __init__(self, model: str = "openai/whisper-1", api_base: str | None = None, api_key: str | None = None,
+                 language: str | None = "en", prompt: str | None = None, timeout_s: float = 30.0) -> None:
+        if not model:
+            raise ValueError("asr.model is empty: name a litellm transcription model, e.g. openai/whisper-1")
+        self.model, self.api_base, self.api_key = model, api_base, api_key
+        self.language, self.prompt, self.timeout_s = language, prompt, timeout_s
+        self.last_latency_s: float | None = None
+
+    def transcribe(self, audio: str | Path) -> str:
+        path = Path(audio)
+        if not path.is_file():
+            raise ASRError(f"audio file {path} does not exist")
+        if path.suffix.lower() not in AUDIO_SUFFIXES:
+            raise ASRError(f"audio file {path} has suffix {path.suffix!r}; use one of {', '.join(AUDIO_SUFFIXES)}")
+        import litellm  # heavy import, only when audio is transcribed
+
+        optional = {k: v for k, v in (("language", self.language), ("prompt", self.prompt)) if v}
+        started = time.perf_counter()
+        try:
+            with path.open("rb") as handle:
+                response = litellm.transcription(model=self.model, file=handle, api_base=self.api_base,
+                                                 api_key=self.api_key, timeout=self.timeout_s, **optional)
+        except Exception as exc:
+            raise ASRError(f"transcription of {path.name} by {self.model} at {self.api_base or 'provider default'} "
+                           f"failed: {type(exc).__name__}: {str(exc)[:300]} (check asr.model, asr.api_base, "
+                           "asr.api_key)") from exc
+        self.last_latency_s = time.perf_counter() - started
+        text = (getattr(response, "text", None) or "").strip()
+        log.info("transcribed %s in %.2f s: %r", path.name, self.last_latency_s, text[:80])
+        return text
