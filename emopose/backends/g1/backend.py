@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 
 class G1Backend(HandoverMixin):
     name = "g1"
+    realtime = True  # the run context drives this backend with the wall clock, never virtual time
 
     def __init__(
         self,
