@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# One-command install on Debian 12 (root or sudo): system libraries, the CPU build of torch, Cyclone DDS
+# 0.10.2 for the G1 backend, and EmoPose itself in editable mode with every extra.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive PIP_DISABLE_PIP_VERSION_CHECK=1
+
+$SUDO apt-get update -qq
+# espeak-ng: local TTS with word events; chromium: web UI tests; cyclonedds-dev: the G1's DDS (0.10.2);
+# EGL/Mesa: offscreen MuJoCo rendering (MUJOCO_GL=egl).
+$SUDO apt-get install -y -qq --no-install-recommends \
+  espeak-ng libespeak-ng1 chromium chromium-driver cyclonedds-dev cyclonedds-tools \
+  libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1 libosmesa6 > /dev/null
+
+python -m pip install -q torch==2.13.0   # the local CPU build; a looser pin pulls GBs of CUDA wheels
+bash .ci/install_cyclonedds.sh            # builds cyclonedds==0.10.2 against Debian's C library
+python -m pip install -q -e ".[embed,web,g1,dev]"
+echo "EmoPose installed. Try: python -m emopose +experiment=bench_hard"
