@@ -1,0 +1,113 @@
+"""LLM planner throughput and robustness against a local fake provider (no network, no API key).
+
+480 requests (one EmoPose-Bench run) go through LLMPlanner.plan_many -> litellm -> real HTTP on
+127.0.0.1 to tests/planners/fake_openai.py, which answers every request after --delay seconds;
+--bad-rate of the answers are bad, half malformed JSON and half HTTP 500 (each retry draws again).
+Reports wall time (target <= 15 s for 480 requests at 200 ms), crashes (plan_many raising or an
+output missing: target 0), retries, fallbacks, how the parser saw the answers, and latency.
+The response cache is off so every request reaches the server.
+Run: python benchmarks/llm_bench_fake.py [--requests 480] [--concurrency 16]  -> JSON on stdout.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from collections import Counter
+from contextlib import contextmanager
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+
+from conftest import load_library, make_library_dir
+
+from emopose.planners.base import PlanRequest, plan_all
+from emopose.planners.llm import LLMPlanner
+from emopose.stages.parse import parse_plan
+
+FAKE_SERVER = ROOT / "tests" / "planners" / "fake_openai.py"
+
+
+@contextmanager
+def fake_server(delay_s: float, bad_rate: float, seed: int):
+    """The fake provider in its own process, as a real provider would be: (url, stats())."""
+    proc = subprocess.Popen([sys.executable, str(FAKE_SERVER), "--delay", str(delay_s), "--bad-rate",
+                             str(bad_rate), "--seed", str(seed)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                            text=True)
+    try:
+        url = json.loads(proc.stdout.readline())["url"]
+        stats_url = url.removesuffix("/v1") + "/stats"
+
+        def stats() -> dict:
+            with urllib.request.urlopen(stats_url, timeout=5) as response:
+                return json.load(response)
+
+        yield url, stats
+    finally:
+        proc.stdin.close()  # the server exits when its stdin closes
+        try:
+            proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--requests", type=int, default=480)
+    parser.add_argument("--delay", type=float, default=0.2, help="server answer time, s")
+    parser.add_argument("--bad-rate", type=float, default=0.2)
+    parser.add_argument("--concurrency", type=int, default=16)
+    parser.add_argument("--max-retries", type=int, default=3)
+    parser.add_argument("--backoff", type=float, default=1.0, help="first backoff, s (planner default 1.0)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--model", default="openai/gpt-4o-mini", help="any litellm model string; served by the fake")
+    parser.add_argument("--target-s", type=float, default=15.0)
+    args = parser.parse_args()
+
+    logging.getLogger("emopose.stages.parse").setLevel(logging.ERROR)  # 10% malformed: expected warnings
+    with tempfile.TemporaryDirectory() as tmp, fake_server(args.delay, args.bad_rate, args.seed) as (url, stats):
+        library = load_library(make_library_dir(Path(tmp) / "library"))
+        planner = LLMPlanner(library=library, template=str(ROOT / "prompts/structured.md"),
+                             demonstrations=str(ROOT / "prompts/demonstrations.jsonl"),
+                             model=args.model, api_base=url, cache=False,
+                             concurrency=args.concurrency, max_retries=args.max_retries,
+                             backoff_s=args.backoff, timeout_s=10.0)
+        requests = [PlanRequest(f"Item {k}: the charging dock is over there by the window.")
+                    for k in range(args.requests)]
+        planner.plan(requests[0])  # warm-up outside the timing: litellm's lazy imports take seconds
+        planner.reset_stats()
+        before = stats()
+        started = time.perf_counter()
+        try:
+            outputs, crash = plan_all(planner, requests), None
+        except Exception as exc:  # noqa: BLE001 - the benchmark's point is that this never happens
+            outputs, crash = [], f"{type(exc).__name__}: {exc}"
+        wall_s = time.perf_counter() - started
+        after, counters = stats(), planner.stats()
+    served = Counter(after["served"])
+    served.subtract(before["served"])
+    sources = Counter(parse_plan(o.raw, r.utterance).source for o, r in zip(outputs, requests))
+    report = {
+        "requests": args.requests, "model": args.model, "concurrency": args.concurrency,
+        "answer_delay_s": args.delay, "bad_rate": args.bad_rate,
+        "wall_s": round(wall_s, 3), "target_wall_s": args.target_s, "within_target": wall_s <= args.target_s,
+        "requests_per_s": round(args.requests / wall_s, 1),
+        "crashes": int(crash is not None), "crash": crash, "missing_outputs": args.requests - len(outputs),
+        "server_requests": after["requests"] - before["requests"], "served": dict(+served),
+        "retries": counters["retries"], "fallbacks": sum(o.fallback for o in outputs),
+        "parsed_as": dict(sources),
+        "latency_mean_s": round(counters["latency_mean_s"], 3),
+        "latency_p95_s": round(counters["latency_p95_s"], 3),
+    }
+    print(json.dumps(report, indent=2))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,250 @@
+"""One chat-completion client for every LLM planner: litellm, our own retry loop, a response cache.
+
+The retry loop is ours (litellm's and the OpenAI SDK's own retries are switched off) so the number
+of attempts is visible to counters and tests, and so only transient failures are retried: 429,
+408/409, 5xx, timeouts and dropped connections. A 4xx such as a bad key or a bad request fails at
+once. litellm is imported on first use: it takes seconds to import and most runs never call it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import logging
+import random
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from emopose.planners.llm_cache import ResponseCache, cache_key
+
+TRANSIENT_STATUS = frozenset({408, 409, 429})
+NO_KEY_PLACEHOLDER = "no-key-needed"  # the OpenAI SDK refuses a missing key even for a local server
+
+
+class LLMConfigError(ValueError):
+    """The planner's model configuration cannot work; raised by check() before a benchmark starts."""
+
+
+class LLMCallError(RuntimeError):
+    """A call failed for good (after the retries, or at once for a non-transient error)."""
+
+    def __init__(self, message: str, latency_s: float = 0.0) -> None:
+        super().__init__(message)
+        self.latency_s = latency_s
+
+
+def _litellm():
+    import litellm  # late: seconds to import, and most runs never call a hosted model
+    litellm.suppress_debug_info = True  # otherwise every exception prints a help banner to stdout
+    logging.getLogger("LiteLLM").setLevel(logging.WARNING)  # two INFO lines per call drown a run's log
+    return litellm
+
+
+def is_transient(exc: BaseException) -> bool:
+    litellm = _litellm()
+    if isinstance(exc, (litellm.Timeout, litellm.APIConnectionError)):
+        return True
+    status = getattr(exc, "status_code", None)
+    return isinstance(status, int) and (status in TRANSIENT_STATUS or status >= 500)
+
+
+def backoff_delay(attempt: int, base_s: float, cap_s: float, exc: BaseException | None = None) -> float:
+    """Exponential backoff with jitter (so parallel calls do not retry in lockstep); honours Retry-After."""
+    delay = min(cap_s, base_s * 2**attempt) * (0.5 + random.random() / 2)
+    headers = getattr(exc, "litellm_response_headers", None) or {}
+    with contextlib.suppress(TypeError, ValueError):
+        delay = max(delay, min(cap_s, float(headers.get("retry-after", 0))))
+    return delay
+
+
+@dataclass(frozen=True)
+class Completion:
+    text: str
+    attempts: int
+    cached: bool
+    finish_reason: str | None = None
+    latency_s: float = 0.0  # model time incl. retries and backoff; 0 for a cache hit
+
+
+@dataclass
+class CallCounters:
+    """Counters shared by a client and its planner; thread-safe because the web UI plans from threads."""
+
+    calls: int = 0
+    cache_hits: int = 0
+    retries: int = 0
+    fallbacks: int = 0
+    latencies_s: list[float] = field(default_factory=list)  # model calls only; a cache hit is not inference
+    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+
+    def add(self, **counts: int) -> None:
+        with self._lock:
+            for name, n in counts.items():
+                setattr(self, name, getattr(self, name) + n)
+
+    def latency(self, seconds: float) -> None:
+        with self._lock:
+            self.latencies_s.append(seconds)
+
+    def stats(self) -> dict:
+        with self._lock:
+            lat = np.asarray(self.latencies_s, dtype=float)
+            return {"calls": self.calls, "cache_hits": self.cache_hits, "retries": self.retries,
+                    "fallbacks": self.fallbacks, "model_calls": int(lat.size),
+                    "latency_mean_s": float(lat.mean()) if lat.size else None,
+                    "latency_p95_s": float(np.percentile(lat, 95)) if lat.size else None}
+
+
+class LLMClient:
+    """Chat completion with any litellm model string (openai/..., anthropic/..., ollama/..., hosted_vllm/...)."""
+
+    def __init__(self, model: str = "openai/gpt-4o-mini", api_base: str | None = None, api_key: str | None = None,
+                 temperature: float = 0.7, max_tokens: int | None = 1024, timeout_s: float = 60.0,
+                 max_retries: int = 3, backoff_s: float = 1.0, backoff_max_s: float = 30.0, cache: bool = True,
+                 cache_dir: str = "~/.cache/emopose/llm", extra_params: dict | None = None) -> None:
+        if not isinstance(model, str) or not model.strip():
+            raise LLMConfigError("planner.model is empty; give a litellm model string such as openai/gpt-4o-mini")
+        for key, value, low in (("temperature", temperature, 0), ("timeout_s", timeout_s, 1e-3),
+                                ("max_retries", max_retries, 0), ("backoff_s", backoff_s, 0)):
+            if value < low:
+                raise LLMConfigError(f"planner.{key} = {value} must be >= {low}")
+        self.model, self.api_base, self.api_key = model, api_base or None, api_key or None
+        self.temperature, self.max_tokens, self.timeout_s = float(temperature), max_tokens, float(timeout_s)
+        self.max_retries, self.backoff_s, self.backoff_max_s = int(max_retries), float(backoff_s), float(backoff_max_s)
+        self.extra_params = dict(extra_params or {})
+        self.cache = ResponseCache(cache_dir) if cache else None
+        self.counters = CallCounters()
+        self._key_resolved: tuple[str | None] | None = None  # decided on the first call (needs litellm)
+        self._repeats: dict[str, int] = {}
+        self._repeats_lock = threading.Lock()
+
+    @property
+    def sampled(self) -> bool:
+        """True when repeated passes are independent draws (temperature > 0; the pass index keys the cache)."""
+        return self.temperature > 0
+
+    def check(self) -> None:
+        """Fail fast on a model string litellm cannot route or a hosted provider without its API key."""
+        litellm = _litellm()
+        try:
+            litellm.get_llm_provider(model=self.model, api_base=self.api_base)
+        except Exception as exc:
+            raise LLMConfigError(
+                f"planner.model = {self.model!r} is not a litellm model string ({str(exc).splitlines()[0][:160]}); "
+                "use provider/name, e.g. openai/gpt-4o-mini, anthropic/claude-3-5-haiku-latest, "
+                "or hosted_vllm/NAME with planner.api_base") from exc
+        if self.api_base or self.api_key:
+            return  # a local or proxy server: it decides whether it wants a key
+        env = litellm.validate_environment(model=self.model)
+        if not env.get("keys_in_environment"):
+            raise LLMConfigError(
+                f"planner.model = {self.model!r} needs {env.get('missing_keys')} in the environment: export it, "
+                "set planner.api_key, or point planner.api_base at a local OpenAI-compatible server")
+
+    # -- one request -------------------------------------------------------------------------
+    def _key(self, messages: list[dict], pass_index: int) -> str:
+        return cache_key({"model": self.model, "api_base": self.api_base, "messages": messages,
+                          "temperature": self.temperature, "max_tokens": self.max_tokens,
+                          "extra": self.extra_params, "pass": pass_index if self.sampled else None})
+
+    def _call_kwargs(self, messages: list[dict]) -> dict:
+        api_key = self._effective_key()
+        kwargs = {"model": self.model, "messages": messages, "temperature": self.temperature,
+                  "timeout": self.timeout_s, "max_retries": 0, "num_retries": 0, **self.extra_params}
+        if self.max_tokens:
+            kwargs["max_tokens"] = self.max_tokens
+        if self.api_base:
+            kwargs["api_base"] = self.api_base
+        if api_key:
+            kwargs["api_key"] = api_key
+        return kwargs
+
+    def _effective_key(self) -> str | None:
+        """The configured key; else litellm reads the provider's env var; a keyless local server gets a placeholder."""
+        if self._key_resolved is None:
+            key = self.api_key
+            if key is None and self.api_base:
+                has_env = _litellm().validate_environment(model=self.model).get("keys_in_environment")
+                key = None if has_env else NO_KEY_PLACEHOLDER
+            self._key_resolved = (key,)
+        return self._key_resolved[0]
+
+    def _draw_key(self, messages: list[dict], pass_index: int) -> str:
+        """The cache key of this call. While sampling, the n-th identical request (n > 0) within this
+        client's life is its own draw: five passes whose job never set pass_index still get five
+        samples, and a rerun in a new process replays them in the same order."""
+        key = self._key(messages, pass_index)
+        if not self.sampled:
+            return key
+        with self._repeats_lock:
+            repeat = self._repeats.get(key, 0)
+            self._repeats[key] = repeat + 1
+        return cache_key({"draw": key, "repeat": repeat}) if repeat else key
+
+    def _lookup(self, messages: list[dict], pass_index: int) -> tuple[str | None, Completion | None]:
+        self.counters.add(calls=1)
+        if self.cache is None:
+            return None, None
+        key = self._draw_key(messages, pass_index)
+        text = self.cache.get(key)
+        if text is None:
+            return key, None
+        self.counters.add(cache_hits=1)
+        return key, Completion(text, attempts=0, cached=True)
+
+    def _retry_delay(self, exc: Exception, attempt: int, started: float) -> float:
+        """Backoff before the next attempt, or raise LLMCallError when the failure is final."""
+        if attempt >= self.max_retries or not is_transient(exc):
+            latency = time.perf_counter() - started
+            self.counters.latency(latency)
+            raise LLMCallError(f"{type(exc).__name__} after {attempt + 1} attempt(s): {str(exc)[:300]}",
+                               latency) from exc
+        self.counters.add(retries=1)
+        return backoff_delay(attempt, self.backoff_s, self.backoff_max_s, exc)
+
+    def _finish(self, key: str | None, response, attempts: int, started: float) -> Completion:
+        latency = time.perf_counter() - started
+        self.counters.latency(latency)
+        choice = response.choices[0]
+        text = choice.message.content or ""
+        if self.cache and key and text.strip():  # an empty answer is usually a provider hiccup: ask again next time
+            self.cache.put(key, text, {"model": self.model, "finish_reason": choice.finish_reason})
+        return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason, latency_s=latency)
+
+    def complete(self, messages: list[dict], pass_index: int = 0) -> Completion:  # type: ignore[return]
+        """The answer to one chat request: from the cache, or from the model with retries."""
+        key, hit = self._lookup(messages, pass_index)
+        if hit is not None:
+            return hit
+        kwargs, started = self._call_kwargs(messages), time.perf_counter()
+        for attempt in itertools.count():
+            try:
+                response = _litellm().completion(**kwargs)
+            except Exception as exc:  # noqa: BLE001 - litellm raises many types; is_transient sorts them
+                time.sleep(self._retry_delay(exc, attempt, started))
+                continue
+            return self._finish(key, response, attempt + 1, started)
+
+    async def acomplete(self, messages: list[dict], pass_index: int = 0,
+                        gate: asyncio.Semaphore | None = None) -> Completion:  # type: ignore[return]
+        """As complete(); `gate` bounds requests on the wire (a call in backoff frees its slot). Queueing
+        for a slot is the batch's scheduling, not model latency: the latency origin skips it."""
+        key, hit = self._lookup(messages, pass_index)
+        if hit is not None:
+            return hit
+        kwargs, slot, started = self._call_kwargs(messages), gate or contextlib.nullcontext(), None
+        for attempt in itertools.count():
+            queued = time.perf_counter()
+            async with slot:
+                started = time.perf_counter() if started is None else started + time.perf_counter() - queued
+                try:
+                    response = await _litellm().acompletion(**kwargs)
+                except Exception as exc:  # noqa: BLE001 - as in complete()
+                    delay = self._retry_delay(exc, attempt, started)
+                else:
+                    return self._finish(key, response, attempt + 1, started)
+            await asyncio.sleep(delay)

@@ -1,0 +1,97 @@
+"""Prompt files, the library guide, and the planner configs composed through Hydra."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+from hydra import compose, initialize_config_dir
+
+from emopose import CLASSES
+from emopose.build import ConfigError, make
+from emopose.config import CONFIG_DIR, PROJECT_ROOT
+from emopose.planners.direct_label import DirectLabelPlanner
+from emopose.planners.guide import library_guide
+from emopose.planners.llm import LLMPlanner
+from emopose.planners.prompting import PromptError, PromptTemplate
+
+
+def _section(path, title: str) -> str:
+    text = PromptTemplate.load(path).text
+    return re.search(rf"^## {title}\n(.*?)(?=^## )", text, re.DOTALL | re.MULTILINE).group(1)
+
+
+def test_both_templates_share_the_class_definitions():
+    structured = _section(PROJECT_ROOT / "prompts/structured.md", "Classes")
+    assert structured == _section(PROJECT_ROOT / "prompts/direct_label.md", "Classes")
+    assert [line.split(":")[0][2:] for line in structured.splitlines() if line.startswith("- ")] == list(CLASSES)
+
+
+def test_template_header_is_stripped_and_fields_declared():
+    template = PromptTemplate.load(PROJECT_ROOT / "prompts/structured.md")
+    assert not template.text.startswith("<!--")
+    assert template.fields == {"library_guide", "demonstrations", "max_gestures", "mode"}
+    with pytest.raises(PromptError, match="labels"):
+        template.require("labels")
+
+
+def test_guide_lists_classes_in_order_with_defaults(writable_library):
+    guide = library_guide(writable_library)
+    heads = [line[:-1] for line in guide.splitlines() if not line.startswith(" ")]
+    assert heads == list(CLASSES)
+    assert "  - pointing_a (class default): pointing a test motion" in guide
+    assert "neutral_rest" not in guide  # the built-in rest pose is not offered as a gesture
+    assert library_guide(writable_library) is guide  # cached while the version is unchanged
+    writable_library.reload()
+    assert library_guide(writable_library) == guide and library_guide(writable_library) is not guide
+
+
+def _compose(overrides):
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        return compose("config", overrides=overrides)
+
+
+def test_planner_configs_compose_and_build(writable_library, demonstrations_file, tmp_path):
+    common = [f"prompt.demonstrations={demonstrations_file}", f"planner.cache_dir={tmp_path}"]
+    llm = make(_compose(["planner=llm", *common]).planner, "planner", library=writable_library)
+    assert isinstance(llm, LLMPlanner) and llm.client.temperature == 0.7 and llm.mode == "narrate"
+    label = make(_compose(["planner=direct_label", *common]).planner, "planner", library=writable_library)
+    assert isinstance(label, DirectLabelPlanner) and label.template.path.name == "direct_label.md"
+    wrong = ["planner=llm", f"planner.template={PROJECT_ROOT / 'prompts/direct_label.md'}", *common]
+    with pytest.raises((ConfigError, PromptError), match="library_guide"):
+        make(_compose(wrong).planner, "planner", library=writable_library)
+
+
+def test_demonstration_lines_follow_the_mode(demonstrations_file):
+    from emopose.planners.prompting import load_demonstrations, plan_demonstrations
+
+    demos = load_demonstrations(demonstrations_file)
+    demos = [d.__class__(d.id, d.text, "Robot line " + d.id, d.gestures) for d in demos]
+    assert "User: Robot line demo-1" in plan_demonstrations(demos, "narrate")
+    assert f"User: {demos[0].text}" in plan_demonstrations(demos, "respond")
+
+
+def test_prompt_text_does_not_leak_suite_items():
+    """Everything the model is shown besides the suite item itself: quoted rule examples and demonstration
+    replies (narrate mode shows the replies). Same near-duplicate rule as tests/test_leakage.py."""
+    import json
+
+    from emopose.bench.near_duplicates import Text, cross_duplicates
+
+    suites = []
+    for path in sorted((PROJECT_ROOT / "experiments").glob("*/*suite*.jsonl")) + sorted(
+            (PROJECT_ROOT / "experiments").glob("bench/*.jsonl")):
+        for row in map(json.loads, filter(str.strip, path.read_text(encoding="utf-8").splitlines())):
+            suites.append(Text.of(f"{path.stem}:{row['id']}", row["text"]))
+    if not suites:
+        pytest.skip("no suites written yet")
+    shown = []
+    for name in ("structured.md", "direct_label.md"):
+        for k, quote in enumerate(re.findall(r'"([^"$]{6,})"', (PROJECT_ROOT / "prompts" / name).read_text())):
+            shown.append(Text.of(f"{name}:{k}", quote))
+    demos = PROJECT_ROOT / "prompts/demonstrations.jsonl"
+    if demos.is_file():
+        for row in map(json.loads, filter(str.strip, demos.read_text(encoding="utf-8").splitlines())):
+            shown.append(Text.of(f"demo-reply:{row['id']}", row["reply"]))
+    pairs = cross_duplicates(suites, shown)
+    assert not pairs, pairs[:5]
