@@ -1,0 +1,57 @@
+"""+experiment=serve: the web UI on a live robot (chat, simulation view, Pose Studio).
+
+The control loop runs on its own thread in real time for as long as the server runs; turns are
+planned on a worker thread. uvicorn owns the main thread until Ctrl-C, then everything is released
+(RunContext.close stops the loop and the backend). Settings are validated when the job is built, so
+a bad serve.* value (say, a network bind without a token) stops before anything starts.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+from emopose.build import ConfigError
+from emopose.clock import MonotonicClock
+from emopose.context import RunContext
+from emopose.jobs.report import write_results
+from emopose.web.settings import ServeSettings
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class ServeJob:
+    serve: dict = field(default_factory=dict)
+    render: bool = True  # false: no MuJoCo frames anywhere (stick figure only)
+
+    def __post_init__(self) -> None:
+        self.settings = ServeSettings.model_validate(self.serve)
+
+    def __call__(self, ctx: RunContext) -> dict:
+        if not isinstance(ctx.clock, MonotonicClock):
+            raise ConfigError("serve needs real time: run with run.clock=monotonic (the serve experiment sets it)")
+        import uvicorn  # the web extras load only when serving
+
+        from emopose.web.app import create_app
+        from emopose.web.live import open_session
+
+        session = open_session(ctx, self.settings, render=self.render)  # renderer first: its setup holds the GIL
+        try:
+            ctx.open()
+            ctx.loop.start()
+            app = create_app(session)
+            s = self.settings
+            print(f"EmoPose UI: http://{s.host}:{s.port}/  (Pose Studio: /studio)"
+                  + ("  -- open it with ?token=<serve.token>" if s.token else ""), flush=True)
+            uvicorn.run(app, host=s.host, port=s.port, ws_max_size=s.max_ws_message_bytes,
+                        log_level="warning", access_log=False)
+        finally:
+            session.close()
+            ctx.loop.stop()
+        turns = [m for m in session.log_since(0) if m["type"] == "turn"]
+        results = {"turns": len(turns), "backend": ctx.backend.name, "planner": ctx.planner.name,
+                   "library_version": ctx.library.version, "loop": ctx.loop.stats.summary()}
+        write_results(ctx.run_dir, results, f"Served {len(turns)} turn(s) on {ctx.backend.name} with "
+                                            f"planner {ctx.planner.name}; control loop {results['loop']}")
+        return results

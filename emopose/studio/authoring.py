@@ -1,0 +1,120 @@
+"""Pose Studio's view of a draft motion: the trajectory the robot would run, and the checks before saving.
+
+The preview runs the execution code itself: Eq. intensity (modulate_keyframes with the pipeline's
+gains and margin), Eq. smoothstep (TrajectoryBuilder.build) from the neutral rest pose, and the
+sequencer's own safety hook; so what Pose Studio shows is what the sequencer would accept or reject.
+Every intensity level is checked, because the planner may ask for any of them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from pydantic import ValidationError
+
+from emopose.contract import LibraryEntry
+from emopose.library import MotionLibrary
+from emopose.robot.collision import SelfCollisionChecker
+from emopose.stages.modulate import INTENSITY_GAINS, LIMIT_MARGIN, modulate_keyframes
+from emopose.trajectory import Trajectory, TrajectoryBuilder
+
+LEVELS = (1, 2, 3, 4, 5)
+NOMINAL_LEVEL = 3  # the library sequence as authored; saving requires it to pass
+
+
+class DraftError(ValueError):
+    """The draft cannot be built (wrong shape, keyframe count...); the message says what to change."""
+
+
+@dataclass(frozen=True)
+class LevelCheck:
+    intensity: int
+    ok: bool
+    reason: str | None
+    min_clearance_m: float
+    stretch: float
+
+
+@dataclass(frozen=True)
+class DraftReport:
+    intensity: int
+    duration: float
+    default_duration: float
+    explicit_duration: bool
+    keyframes: np.ndarray  # (K, 14) after Eq. intensity
+    trajectory: Trajectory  # (N + 1, 14) at 50 Hz from the neutral pose
+    keyframe_violations: list[str]  # joints outside the library's limits (+ margin): the library refuses these
+    trajectory_violations: list[str]
+    levels: list[LevelCheck]
+
+    @property
+    def problems(self) -> list[str]:
+        """What blocks saving."""
+        out = []
+        if self.keyframe_violations:
+            out.append(f"keyframes leave the joint limits for {', '.join(self.keyframe_violations)}")
+        nominal = next(c for c in self.levels if c.intensity == NOMINAL_LEVEL)
+        if not nominal.ok:
+            out.append(f"self-collision at intensity {NOMINAL_LEVEL}: {nominal.reason}")
+        return out
+
+    @property
+    def warnings(self) -> list[str]:
+        return [f"intensity {c.intensity} would be rejected by the sequencer: {c.reason}"
+                for c in self.levels if not c.ok and c.intensity != NOMINAL_LEVEL]
+
+
+class PoseStudio:
+    def __init__(self, library: MotionLibrary, safety: Callable[[np.ndarray], str | None] | None = None,
+                 checker: SelfCollisionChecker | None = None, gains: tuple[float, ...] = INTENSITY_GAINS,
+                 margin: float = LIMIT_MARGIN) -> None:
+        self.library, self.safety = library, safety
+        self.checker = checker or SelfCollisionChecker()
+        self.gains, self.margin = tuple(gains), margin
+        self.builder = TrajectoryBuilder(library.limits)
+
+    @classmethod
+    def from_context(cls, ctx) -> PoseStudio:
+        """Use the running pipeline's modulation constants and the sequencer's safety hook."""
+        modulate = next((s for s in ctx.pipeline.stages if s.name == "modulate"), None)
+        gains = getattr(modulate, "gains", INTENSITY_GAINS)
+        margin = getattr(modulate, "margin", LIMIT_MARGIN)
+        return cls(ctx.library, ctx.sequencer.safety, gains=gains, margin=margin)
+
+    def draft(self, keyframes: list[list[float]], motion_type: str = "sequence",
+              duration: float | None = None) -> LibraryEntry:
+        """Schema-check the keyframes (not the limits: those are reported, so the author can fix them)."""
+        raw = {"name": "studio_draft", "class": "neutral", "description": "Pose Studio draft",
+               "motion_type": motion_type, "duration": duration, "keyframes": keyframes}
+        try:
+            return LibraryEntry.model_validate(raw)
+        except ValidationError as exc:
+            problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'draft'}: {e['msg']}" for e in exc.errors())
+            raise DraftError(problems) from exc
+
+    def report(self, entry: LibraryEntry, intensity: int = NOMINAL_LEVEL) -> DraftReport:
+        start = self.library.neutral_entry.q[0]
+        levels, chosen = [], None
+        for level in LEVELS:
+            q = modulate_keyframes(entry.q, level, self.library.limits, self.gains, self.margin)
+            trajectory = self.builder.build(q, entry.default_duration, start)
+            levels.append(self._check(level, trajectory))
+            if level == intensity:
+                chosen = (q, trajectory)
+        keyframes, trajectory = chosen
+        limits = self.library.limits
+        rule = entry.model_copy(update={"duration": None}).default_duration  # Eq. duration, shown beside
+        return DraftReport(
+            intensity=intensity, duration=entry.default_duration, default_duration=rule,
+            explicit_duration=entry.duration is not None, keyframes=keyframes, trajectory=trajectory,
+            keyframe_violations=limits.violations(entry.q, self.library.limit_margin),
+            trajectory_violations=limits.violations(trajectory.samples), levels=levels)
+
+    def _check(self, level: int, trajectory: Trajectory) -> LevelCheck:
+        collision = self.checker.check(trajectory.samples)
+        # The sequencer's hook is the authority (it carries the configured clearance); without one
+        # (safety=off) the default checker still informs the author.
+        reason = self.safety(trajectory.samples) if self.safety is not None else collision.reason
+        return LevelCheck(level, reason is None, reason, float(collision.min_clearance_m), float(trajectory.stretch))

@@ -1,0 +1,81 @@
+"""Saving a Pose Studio motion into the live library.
+
+MotionLibrary.save validates, writes atomically, keeps a backup of a replaced file and reloads (so
+the resolver and every planner's guide see the motion at once). This adds the checks that belong at
+the request edge: the name pattern, an explicit overwrite, the target folder, and the studio's own
+verdict (limits and self-collision at the nominal intensity) so an unusable motion is never stored.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from emopose.contract import LibraryEntry
+from emopose.library import LibraryError, MotionLibrary
+from emopose.studio.authoring import PoseStudio
+
+NAME_PATTERN = r"^[a-z][a-z0-9_]{1,63}$"
+
+
+def valid_name(name: object) -> bool:
+    """Motion names double as file names: the strict pattern rules out traversal and odd characters."""
+    return isinstance(name, str) and re.fullmatch(NAME_PATTERN, name) is not None
+
+
+class SaveRefused(ValueError):
+    """The motion is not saved; `status` is the HTTP status that says why (409 exists, 422 invalid)."""
+
+    def __init__(self, message: str, status: int = 422) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+@dataclass(frozen=True)
+class SaveResult:
+    entry: LibraryEntry
+    file: Path
+    backup: Path | None
+    version: int
+    replaced: bool
+
+
+def target_path(library: MotionLibrary, name: str) -> Path:
+    """Where `name` would be written; refuses anything that does not resolve into a library folder."""
+    if not valid_name(name):
+        raise SaveRefused(f"motion name {name!r} must match ^[a-z][a-z0-9_]{{1,63}}$ "
+                          "(lower case, digits, underscores; starts with a letter)")
+    if library.write_dir is None:
+        raise SaveRefused("this library is read-only: set library.write_dir to save motions", 409)
+    existing = library.snapshot.files.get(name)
+    target = existing if existing is not None else library.write_dir / f"{name}.yaml"
+    folders = {p.resolve() for p in library.paths}
+    if target.resolve().parent not in folders:
+        raise SaveRefused(f"refusing to write {name}: it would land outside the library folders", 403)
+    return target
+
+
+def save_motion(studio: PoseStudio, raw: dict, overwrite: bool = False) -> SaveResult:
+    library = studio.library
+    name = raw.get("name")
+    target = target_path(library, name)
+    replaced = library.get(name) is not None
+    if replaced and not overwrite:
+        raise SaveRefused(f"a motion named {name!r} exists; save with overwrite to replace it "
+                          "(the old file is kept in .backup/)", 409)
+    if replaced and name == library.neutral and raw.get("class") != "neutral":
+        raise SaveRefused(f"{name!r} is the neutral rest pose; it must stay class neutral")
+    try:
+        entry = library.validate(raw, source=f"motion {name!r}")
+    except LibraryError as exc:
+        raise SaveRefused(str(exc)) from exc
+    problems = studio.report(entry).problems
+    if problems:
+        raise SaveRefused(f"motion {name!r} not saved: " + "; ".join(problems))
+    backup = target.parent / ".backup" / f"{target.stem}.v{library.version}.yaml" if target.exists() else None
+    try:
+        saved = library.save(raw)
+    except LibraryError as exc:
+        raise SaveRefused(str(exc)) from exc
+    return SaveResult(saved, target, backup if backup and backup.exists() else None, library.version, replaced)

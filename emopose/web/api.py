@@ -1,0 +1,114 @@
+"""HTTP API of the live robot: info, status, turns (typed or spoken), named gestures, interrupt, audio.
+
+The WebSocket carries the same actions for the page; these routes serve scripts and tests.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+from fastapi import APIRouter, HTTPException, Request
+from fastapi.responses import FileResponse
+
+from emopose.contract import GestureRecord
+from emopose.speech.asr import ASRError
+from emopose.stages.resolve import resolve_record
+from emopose.web.schemas import GestureRequest, ResolveRequest, SayRequest
+from emopose.web.session import LiveSession, UnknownMotion
+
+router = APIRouter(prefix="/api")
+
+# What MediaRecorder produces in Chromium / Firefox, mapped to the suffix the ASR expects.
+AUDIO_TYPES = {"audio/webm": ".webm", "audio/ogg": ".ogg", "audio/wav": ".wav", "audio/x-wav": ".wav",
+               "audio/mpeg": ".mp3", "audio/mp4": ".m4a"}
+
+
+def session_of(request: Request) -> LiveSession:
+    return request.app.state.session
+
+
+@router.get("/health")
+def health() -> dict:
+    return {"ok": True}
+
+
+@router.get("/info")
+def info(request: Request) -> dict:
+    return session_of(request).info()
+
+
+@router.get("/status")
+def status(request: Request) -> dict:
+    return session_of(request).status(events_from=max(0, len(session_of(request).ctx.sequencer.events) - 20))
+
+
+@router.get("/turns")
+def turns(request: Request) -> dict:
+    return {"log": session_of(request).log_since(0)}
+
+
+@router.post("/say")
+async def say(body: SayRequest, request: Request) -> dict:
+    session = session_of(request)
+    return await session.say(body.text, camera_image(session) if body.attach_camera else None)
+
+
+@router.post("/gesture")
+async def gesture(body: GestureRequest, request: Request) -> dict:
+    try:
+        return await session_of(request).gesture(body.name, body.intensity, body.text)
+    except UnknownMotion as exc:
+        raise HTTPException(404, str(exc)) from exc
+
+
+@router.post("/resolve")
+def resolve(body: ResolveRequest, request: Request) -> dict:
+    """The resolver on the live library, without executing: which entry a record would run."""
+    library = session_of(request).ctx.library
+    resolved = resolve_record(GestureRecord(cls=body.cls, variant=body.variant), library)
+    return {**resolved.audit(), "library_version": library.version}
+
+
+@router.post("/interrupt")
+def interrupt(request: Request) -> dict:
+    return session_of(request).interrupt()
+
+
+@router.get("/audio/{turn_id}")
+def audio(turn_id: int, request: Request) -> FileResponse:
+    path = session_of(request).audio_path(turn_id)  # only files the session registered, never a client path
+    if path is None or not path.is_file():
+        raise HTTPException(404, f"turn {turn_id} has no audio (tts=none, or the turn is unknown)")
+    return FileResponse(path, media_type="audio/wav")
+
+
+@router.post("/utterance/audio")
+async def utterance_audio(request: Request) -> dict:
+    """Microphone input: transcribe with the configured ASR, then run the turn."""
+    session = session_of(request)
+    if not session.info()["asr"]:
+        raise HTTPException(409, "no speech recognition configured; type the utterance (or run with asr=litellm)")
+    media = request.headers.get("content-type", "").split(";")[0].strip().lower()
+    if media not in AUDIO_TYPES:
+        raise HTTPException(415, f"audio type {media!r} not accepted; use one of {sorted(AUDIO_TYPES)}")
+    body = await request.body()  # already bounded by serve.max_audio_bytes
+    if not body:
+        raise HTTPException(400, "empty audio")
+    with tempfile.TemporaryDirectory(prefix="emopose-mic-") as folder:
+        path = Path(folder) / f"utterance{AUDIO_TYPES[media]}"
+        path.write_bytes(body)
+        try:
+            text = await session.transcribe(path)
+        except ASRError as exc:
+            raise HTTPException(422, str(exc)) from exc
+    if not text.strip():
+        raise HTTPException(422, "the recording contained no recognisable speech")
+    return await session.say(text[:2000])
+
+
+def camera_image(session: LiveSession) -> bytes | None:
+    """The camera feed's latest JPEG, for a planner that accepts an image with the utterance."""
+    if session.frames is None or "camera" not in session.frames.channels:
+        return None
+    return session.frames.latest("camera")[1]

@@ -1,0 +1,89 @@
+"""Request bodies and WebSocket messages: validated once at the edge, with bounded sizes.
+
+Every string and list has a maximum so a request can never make the server build something large;
+motion names use the library's file-name pattern, so no name can point outside library/.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from emopose import CLASSES
+from emopose.studio.saving import NAME_PATTERN
+
+MotionName = Annotated[str, Field(pattern=NAME_PATTERN, description="a library motion name")]
+GestureClass = Literal[CLASSES]  # type: ignore[valid-type]
+Keyframe = Annotated[list[float], Field(min_length=14, max_length=14)]
+Intensity = Annotated[int, Field(ge=1, le=5)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class SayRequest(_Strict):
+    text: str = Field(min_length=1, max_length=2000)
+    attach_camera: bool = False  # send the current camera frame to the planner as the turn's image
+
+
+class GestureRequest(_Strict):
+    name: MotionName
+    intensity: Intensity = 3
+    text: str | None = Field(default=None, max_length=500)  # an optional reply to speak with it
+
+
+class ResolveRequest(_Strict):
+    cls: GestureClass = Field(alias="class")
+    variant: str | None = Field(default=None, max_length=64)
+
+
+class DraftRequest(_Strict):
+    keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
+    motion_type: Literal["sequence", "pose"] = "sequence"
+    duration: float | None = Field(default=None, gt=0.0, le=20.0)  # None: Eq. duration
+    intensity: Intensity = 3
+
+
+class PreviewRequest(DraftRequest):
+    camera: Literal["front", "oblique", "side", "head"] = "front"
+    frames: int | None = Field(default=None, ge=1, le=60)
+
+
+class SaveRequest(_Strict):
+    model_config = ConfigDict(extra="forbid", populate_by_name=True, allow_inf_nan=False)
+
+    name: str = Field(min_length=1, max_length=64)  # checked against the pattern in saving.py (clear message)
+    cls: GestureClass = Field(alias="class")
+    description: str = Field(min_length=3, max_length=200)
+    motion_type: Literal["sequence", "pose"] = "sequence"
+    duration: float | None = Field(default=None, gt=0.0, le=20.0)
+    keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
+    overwrite: bool = False
+
+    def motion(self) -> dict:
+        """The library-file mapping (what MotionLibrary.save validates)."""
+        data = self.model_dump(by_alias=True, exclude={"overwrite"}, exclude_none=True)
+        return data
+
+
+# -- WebSocket, client -> server ---------------------------------------------------------------
+class SayMessage(SayRequest):
+    type: Literal["say"]
+
+
+class GestureMessage(GestureRequest):
+    type: Literal["gesture"]
+
+
+class InterruptMessage(_Strict):
+    type: Literal["interrupt"]
+
+
+class PingMessage(_Strict):
+    type: Literal["ping"]
+
+
+ClientMessage = Annotated[SayMessage | GestureMessage | InterruptMessage | PingMessage,
+                          Field(discriminator="type")]

@@ -1,0 +1,119 @@
+// The chat page: dialogue history with timed cues, the composer, and the live robot panel.
+import { api, connect, el, fillBadges } from "./common.js";
+import { ReplyPlayer, showPlayed, turnBubble } from "./cues.js";
+import { RobotPanel } from "./robot.js";
+
+const $ = (id) => document.getElementById(id);
+const history = $("history");
+const robot = new RobotPanel();
+let players = [];
+let pending = null;
+let libraryVersion = null;
+
+function showError(message) {
+  const banner = $("error");
+  banner.textContent = message;
+  banner.classList.toggle("hidden", !message);
+  if (message) setTimeout(() => banner.classList.add("hidden"), 6000);
+}
+
+function scrollDown() { history.scrollTop = history.scrollHeight; }
+
+function userBubble(text, gesture = false) {
+  return el("div", { class: `bubble user${gesture ? " gesture" : ""}`, text });
+}
+
+function addTurn(turn, live) {
+  if (pending) { pending.remove(); pending = null; }
+  if (turn.kind === "gesture") history.append(userBubble(`▶ perform ${turn.cues[0]?.requested ?? ""} (i${turn.cues[0]?.intensity ?? 3})`, true));
+  else if (!history.lastElementChild?.matches(`.bubble.user[data-utterance]`)) history.append(userBubble(turn.utterance));
+  history.querySelectorAll(".bubble.user[data-utterance]").forEach((n) => n.removeAttribute("data-utterance"));
+  const bubble = turnBubble(turn);
+  history.append(bubble);
+  if (live) {
+    players.forEach((p) => p.cancel()); // the server interrupted the previous reply
+    players = [new ReplyPlayer(bubble, turn)];
+  } else showPlayed(bubble);
+  scrollDown();
+}
+
+function onMessage(msg) {
+  switch (msg.type) {
+    case "hello":
+      fillBadges($("badges"), msg);
+      libraryVersion = msg.library_version;
+      robot.configure(msg);
+      $("mic").classList.toggle("hidden", !msg.asr);
+      $("attach-wrap").classList.toggle("hidden", !msg.channels.camera);
+      history.replaceChildren();
+      msg.log.filter((m) => m.type === "turn").forEach((t) => addTurn(t, false));
+      loadMotions();
+      break;
+    case "turn_started":
+      history.append(userBubble(msg.utterance));
+      history.lastElementChild.setAttribute("data-utterance", ""); // addTurn will not repeat it
+      pending = el("div", { class: "bubble robot pending", text: "planning…" });
+      history.append(pending);
+      scrollDown();
+      break;
+    case "turn": addTurn(msg, true); break;
+    case "interrupted": players.forEach((p) => p.cancel()); break;
+    case "library_saved": loadMotions(msg.name); break;
+    case "state":
+      robot.update(msg);
+      if (msg.library_version !== libraryVersion) { libraryVersion = msg.library_version; loadMotions(); }
+      break;
+    case "error": showError(msg.message); if (pending) { pending.remove(); pending = null; } break;
+  }
+}
+
+async function loadMotions(select) {
+  const library = await api("/api/library");
+  const picker = $("gesture-name");
+  const current = select || picker.value;
+  picker.replaceChildren(...library.classes.map((cls) => el("optgroup", { label: cls },
+    library.entries.filter((e) => e.class === cls).map((e) => el("option", { value: e.name, text: e.name })))));
+  if (current && library.entries.some((e) => e.name === current)) picker.value = current;
+  document.querySelector("#library-badge b")?.replaceChildren(String(library.version));
+}
+
+const socket = connect({
+  message: onMessage,
+  frame: (tag, blob) => robot.frame(tag, blob),
+  status: (up) => { $("connection").textContent = up ? "live" : "reconnecting…"; },
+});
+
+$("say-form").addEventListener("submit", (event) => {
+  event.preventDefault();
+  const text = $("say-text").value.trim();
+  if (!text) return;
+  socket.send({ type: "say", text, attach_camera: $("attach").checked });
+  $("say-text").value = "";
+});
+$("gesture-go").addEventListener("click", () => {
+  socket.send({ type: "gesture", name: $("gesture-name").value, intensity: Number($("gesture-intensity").value) });
+});
+$("interrupt").addEventListener("click", () => socket.send({ type: "interrupt" }));
+
+// Microphone (only shown when the server has an ASR): record while pressed, send on release.
+let recorder = null;
+$("mic").addEventListener("pointerdown", async () => {
+  try {
+    const stream = await navigator.mediaDevices.getUserMedia({ audio: true });
+    const chunks = [];
+    recorder = new MediaRecorder(stream);
+    recorder.ondataavailable = (e) => chunks.push(e.data);
+    recorder.onstop = async () => {
+      stream.getTracks().forEach((t) => t.stop());
+      const blob = new Blob(chunks, { type: recorder.mimeType.split(";")[0] });
+      const response = await fetch("/api/utterance/audio", { method: "POST", body: blob, headers: { "Content-Type": blob.type } });
+      if (!response.ok) showError((await response.json()).error);
+    };
+    recorder.start();
+    $("mic").classList.add("recording");
+  } catch (error) { showError(`microphone: ${error.message}`); }
+});
+$("mic").addEventListener("pointerup", () => {
+  if (recorder && recorder.state === "recording") recorder.stop();
+  $("mic").classList.remove("recording");
+});

@@ -1,0 +1,86 @@
+// One robot reply in the history: the text with each gesture's trigger marked, the cue list, and the
+// live highlighting that lights a trigger up at its release time (relative to speech start).
+import { CLASS_COLORS, el } from "./common.js";
+
+function replyNode(reply, cues) {
+  const spans = cues.filter((c) => c.char_start !== null).sort((a, b) => a.char_start - b.char_start);
+  const node = el("div", { class: "reply" });
+  let at = 0;
+  for (const cue of spans) {
+    if (cue.char_start < at) continue; // overlapping triggers: the first one keeps the mark
+    node.append(reply.slice(at, cue.char_start));
+    node.append(el("mark", { "data-k": cue.k, style: `--cue:${CLASS_COLORS[cue.class]}`, text: reply.slice(cue.char_start, cue.char_end) }));
+    at = cue.char_end;
+  }
+  node.append(reply.slice(at));
+  return node;
+}
+
+function cueNode(cue) {
+  const rule = cue.rule === "exact" ? "exact" : cue.rule.replace("_", " ");
+  const asked = cue.requested && cue.requested !== cue.resolved ? ` (asked ${cue.requested})` : "";
+  return el("div", { class: "cue", "data-k": cue.k, style: `--cue:${CLASS_COLORS[cue.resolved_class] || "#888"}` },
+    el("span", { class: "muted", text: cue.class }), "→",
+    el("span", { class: "name", text: cue.resolved }),
+    el("span", { class: "muted", text: `${rule}${asked} · i${cue.intensity}` }),
+    cue.trigger ? el("span", { text: `“${cue.trigger}”` }) : null,
+    el("span", { class: "time", text: cue.release_s === null ? "" : `${cue.release_s.toFixed(2)} s` }));
+}
+
+export function turnBubble(turn) {
+  const bar = el("div", { class: "speechbar" }, el("div"));
+  const meta = `${turn.kind === "gesture" ? "named gesture" : `plan: ${turn.source}`} · speech ${turn.speech.duration_s.toFixed(1)} s`
+    + ` · planner ${(turn.planner_latency_s * 1000).toFixed(0)} ms · library v${turn.library_version}`;
+  return el("div", { class: "bubble robot", "data-turn": turn.turn_id },
+    turn.reply ? replyNode(turn.reply, turn.cues) : null,
+    el("div", { class: "cues" }, turn.cues.map(cueNode)), bar, el("div", { class: "meta", text: meta }));
+}
+
+// Plays one reply: its audio when the server has a WAV, and the highlighting on that clock
+// (or on a timer started at the server's speech start when there is no audio or it cannot play).
+export class ReplyPlayer {
+  constructor(bubble, turn) {
+    this.bubble = bubble; this.turn = turn; this.done = false;
+    const ago = Math.max(0, (turn.now ?? turn.server_now) - (turn.speech_start ?? turn.server_now));
+    this.t0 = performance.now() - ago * 1000;
+    this.audio = null;
+    if (turn.speech.audio) {
+      this.audio = new Audio(turn.speech.audio);
+      this.audio.play().catch(() => { this.audio = null; }); // autoplay refused: keep the timer
+    }
+    this.end = Math.max(turn.speech.duration_s, ...turn.cues.map((c) => c.release_s ?? 0)) + 0.3;
+    requestAnimationFrame(() => this.tick());
+  }
+
+  time() {
+    if (this.audio && !this.audio.paused && this.audio.currentTime > 0) return this.audio.currentTime;
+    return (performance.now() - this.t0) / 1000;
+  }
+
+  tick() {
+    if (this.done) return;
+    const t = this.time();
+    for (const cue of this.turn.cues) {
+      if (cue.release_s !== null && cue.release_s <= t) {
+        this.bubble.querySelectorAll(`[data-k="${cue.k}"]`).forEach((n) => n.classList.add("fired"));
+      }
+    }
+    const bar = this.bubble.querySelector(".speechbar > div");
+    bar.style.width = `${Math.min(100, (100 * t) / Math.max(this.end, 0.01))}%`;
+    if (t >= this.end) { this.done = true; return; }
+    requestAnimationFrame(() => this.tick());
+  }
+
+  cancel() {
+    if (this.done) return;
+    this.done = true;
+    if (this.audio) this.audio.pause();
+    this.bubble.querySelectorAll(".cue:not(.fired)").forEach((n) => n.classList.add("cancelled"));
+  }
+}
+
+// History turns (sent when the page connects) are shown already played.
+export function showPlayed(bubble) {
+  bubble.querySelectorAll("[data-k]").forEach((n) => n.classList.add("fired"));
+  bubble.querySelector(".speechbar > div").style.width = "100%";
+}

@@ -1,0 +1,117 @@
+"""Pose Studio's HTTP API: read the library, build and check a draft, render its preview, save it.
+
+A draft is checked by the execution code itself (emopose.studio.authoring); a save goes through
+emopose.studio.saving (name pattern, overwrite, target folder, verdict) into MotionLibrary.save, whose
+reload makes the motion visible to the resolver and every planner's guide at once.
+"""
+
+from __future__ import annotations
+
+import base64
+
+import numpy as np
+from fastapi import APIRouter, HTTPException, Path, Request
+from fastapi.responses import JSONResponse
+
+from emopose import CLASSES
+from emopose.studio.authoring import DraftError, DraftReport
+from emopose.studio.saving import NAME_PATTERN, SaveRefused, save_motion
+from emopose.web.pose_renderer import RenderUnavailable
+from emopose.web.schemas import DraftRequest, PreviewRequest, SaveRequest
+from emopose.web.session import LiveSession
+from emopose.web.stick_figure import stick_frames
+
+router = APIRouter(prefix="/api")
+STICK_EVERY = 5  # 50 Hz samples -> 10 Hz stick-figure frames
+
+
+def session_of(request: Request) -> LiveSession:
+    return request.app.state.session
+
+
+def _round(a: np.ndarray) -> list:
+    return np.round(np.asarray(a, dtype=float), 4).tolist()
+
+
+@router.get("/library")
+def library_index(request: Request) -> dict:
+    library = session_of(request).ctx.library
+    snapshot, limits = library.snapshot, library.limits
+    entries = [{"name": e.name, "class": e.cls, "description": e.description, "motion_type": e.motion_type,
+                "keyframes": len(e.keyframes), "duration": e.default_duration,
+                "explicit_duration": e.duration is not None} for e in snapshot.entries.values()]
+    return {"version": snapshot.version, "classes": list(CLASSES), "neutral": snapshot.neutral,
+            "neutral_pose": _round(library.neutral_entry.q[0]), "writable": library.write_dir is not None,
+            "limits": {"names": list(limits.names), "lower": _round(limits.lower), "upper": _round(limits.upper)},
+            "class_defaults": snapshot.class_defaults, "entries": entries}
+
+
+@router.get("/library/{name}")
+def library_entry(request: Request, name: str = Path(pattern=NAME_PATTERN)) -> dict:
+    entry = session_of(request).ctx.library.get(name)
+    if entry is None:
+        raise HTTPException(404, f"no motion named {name!r}")
+    return entry.model_dump(mode="json", by_alias=True)
+
+
+def _report(request: Request, body: DraftRequest) -> DraftReport:
+    studio = session_of(request).studio
+    try:
+        entry = studio.draft(body.keyframes, body.motion_type, body.duration)
+    except DraftError as exc:
+        raise HTTPException(422, f"draft: {exc}") from exc
+    return studio.report(entry, body.intensity)
+
+
+@router.post("/studio/check")
+def check(body: DraftRequest, request: Request) -> dict:
+    """The 50 Hz trajectory the robot would run at this intensity, and every check, before saving."""
+    report = _report(request, body)
+    trajectory = report.trajectory
+    k = len(body.keyframes)
+    span = trajectory.duration
+    return {
+        "intensity": report.intensity, "duration": report.duration, "default_duration": report.default_duration,
+        "explicit_duration": report.explicit_duration, "dt": trajectory.dt, "stretch": trajectory.stretch,
+        "samples": _round(trajectory.samples), "keyframes": _round(report.keyframes),
+        "keyframe_times": [span * i / max(k - 1, 1) for i in range(k)] if k > 1 else [span],
+        "keyframe_violations": report.keyframe_violations, "trajectory_violations": report.trajectory_violations,
+        "levels": [vars(c) for c in report.levels], "problems": report.problems, "warnings": report.warnings,
+        "can_save": not report.problems,
+        "stick": stick_frames(trajectory.samples, STICK_EVERY), "stick_dt": trajectory.dt * STICK_EVERY,
+    }
+
+
+@router.post("/studio/preview")
+def preview(body: PreviewRequest, request: Request) -> dict:
+    """A few MuJoCo frames of the trajectory, evenly spaced in time (stick figure when no EGL)."""
+    session = session_of(request)
+    report = _report(request, body)
+    samples = report.trajectory.samples
+    count = min(body.frames or session.settings.preview_frames, len(samples))
+    index = np.unique(np.linspace(0, len(samples) - 1, count).round().astype(int))
+    times = (index * report.trajectory.dt).tolist()
+    if session.renderer is None or not session.renderer.available:
+        return {"frames": [], "times": times, "fallback": "stick",
+                "reason": "MuJoCo offscreen rendering is not available on this server"}
+    try:
+        jpegs = session.renderer.render_many([(samples[i], None) for i in index], body.camera)
+    except RenderUnavailable as exc:
+        return {"frames": [], "times": times, "fallback": "stick", "reason": str(exc)}
+    frames = ["data:image/jpeg;base64," + base64.b64encode(j).decode() for j in jpegs]
+    return {"frames": frames, "times": times, "camera": body.camera, "fallback": None}
+
+
+@router.post("/library", status_code=201)
+def save(body: SaveRequest, request: Request):
+    session = session_of(request)
+    try:
+        result = save_motion(session.studio, body.motion(), overwrite=body.overwrite)
+    except SaveRefused as exc:
+        return JSONResponse({"error": str(exc)}, status_code=exc.status)
+    folder = result.file.parent.name  # shown relative to the library folder, never as an absolute path
+    saved = {"name": result.entry.name, "class": result.entry.cls, "version": result.version,
+             "replaced": result.replaced, "file": f"{folder}/{result.file.name}",
+             "backup": None if result.backup is None else f"{folder}/.backup/{result.backup.name}"}
+    session.publish({"type": "library_saved", **saved})
+    return saved

@@ -1,0 +1,122 @@
+"""The page's WebSocket: actions in (say, gesture, interrupt), live state and frames out.
+
+Receiving and sending run side by side: a turn is started as a task, so an interrupt sent while the
+planner works is handled at once. The sender pushes, at serve.state_hz, the sequencer state with
+new events, the stick figure, every new broadcast-log message (turns, interruptions, saves) and the
+newest frame of each image channel as a binary message: one tag byte ('s' sim, 'c' camera) + JPEG.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+
+from fastapi import APIRouter, WebSocket, WebSocketDisconnect
+from pydantic import TypeAdapter, ValidationError
+
+from emopose.web.api import camera_image
+from emopose.web.schemas import ClientMessage, GestureMessage, InterruptMessage, SayMessage
+from emopose.web.session import LiveSession, UnknownMotion
+
+log = logging.getLogger(__name__)
+router = APIRouter()
+_messages = TypeAdapter(ClientMessage)
+
+
+@router.websocket("/ws")
+async def websocket_endpoint(websocket: WebSocket) -> None:
+    session: LiveSession = websocket.app.state.session
+    await websocket.accept()
+    await websocket.send_json({"type": "hello", **session.info(), "log": session.log_since(0)})
+    watching = session.frames.watching() if session.frames is not None else None
+    if watching is not None:
+        watching.__enter__()
+    sender = asyncio.create_task(_send_loop(websocket, session))
+    tasks: set[asyncio.Task] = set()
+    try:
+        while True:
+            message = await websocket.receive()
+            if message["type"] == "websocket.disconnect":
+                break
+            reply = await _handle(session, message.get("text"), tasks, websocket)
+            if reply is not None:
+                await websocket.send_json(reply)
+    except WebSocketDisconnect:
+        pass
+    finally:
+        sender.cancel()
+        if watching is not None:
+            watching.__exit__(None, None, None)
+
+
+async def _handle(session: LiveSession, text: str | None, tasks: set, websocket: WebSocket) -> dict | None:
+    if text is None:
+        return {"type": "error", "message": "send JSON text messages, not binary"}
+    if len(text) > session.settings.max_ws_message_bytes:
+        return {"type": "error", "message": f"message larger than {session.settings.max_ws_message_bytes} bytes"}
+    try:
+        message = _messages.validate_json(text)
+    except ValidationError as exc:
+        problems = "; ".join(f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()[:5])
+        return {"type": "error", "message": f"invalid message: {problems}"}
+    if isinstance(message, InterruptMessage):
+        session.interrupt()
+        return None
+    if isinstance(message, SayMessage):
+        image = camera_image(session) if message.attach_camera else None
+        action = session.say(message.text, image)
+    elif isinstance(message, GestureMessage):
+        action = session.gesture(message.name, message.intensity, message.text)
+    else:
+        return {"type": "pong"}
+    task = asyncio.create_task(_report_failure(action, websocket))
+    tasks.add(task)
+    task.add_done_callback(tasks.discard)
+    return None
+
+
+async def _report_failure(action, websocket: WebSocket) -> None:
+    """Results reach every page through the broadcast log; failures go back to the asking page."""
+    try:
+        await action
+    except UnknownMotion as exc:
+        await _send_quietly(websocket, {"type": "error", "message": str(exc)})
+    except Exception as exc:  # a failed turn is reported, the session goes on
+        log.exception("turn failed")
+        await _send_quietly(websocket, {"type": "error", "message": f"turn failed: {type(exc).__name__}: {exc}"[:300]})
+
+
+async def _send_quietly(websocket: WebSocket, message: dict) -> None:
+    try:
+        await websocket.send_json(message)
+    except Exception:  # noqa: BLE001 -- the page may have gone away meanwhile
+        log.debug("could not deliver %s to a closed page", message.get("type"))
+
+
+async def _send_loop(websocket: WebSocket, session: LiveSession) -> None:
+    settings = session.settings
+    last_id = max((m["id"] for m in session.log_since(0)), default=0)
+    events_from = len(session.ctx.sequencer.events)
+    frames_seen: dict[str, int] = {}
+    period = 1.0 / max(settings.state_hz, settings.sim_fps)
+    state_every, tick = max(1, round(max(settings.state_hz, settings.sim_fps) / settings.state_hz)), 0
+    try:
+        while True:
+            for message in session.log_since(last_id):
+                last_id = message["id"]
+                await websocket.send_text(json.dumps({**message, "now": session.ctx.clock.now()}))
+            if tick % state_every == 0:
+                state = session.status(events_from)
+                events_from = state.pop("events_next")
+                await websocket.send_text(json.dumps(state))
+            tick += 1
+            if session.frames is not None:
+                for name in session.frames.channels:
+                    seq, jpeg = session.frames.latest(name)
+                    if jpeg is not None and frames_seen.get(name) != seq:
+                        frames_seen[name] = seq
+                        await websocket.send_bytes(name[0].encode() + jpeg)
+            await asyncio.sleep(period)
+    except (WebSocketDisconnect, RuntimeError, asyncio.CancelledError):
+        return

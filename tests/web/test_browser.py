@@ -1,0 +1,181 @@
+"""The web UI in a real headless Chromium (Debian's), driven by Playwright, against the real server.
+
+The server is the real CLI (python -m emopose +experiment=serve) in a subprocess on a free port,
+with the keyword planner and a temporary copy of library/g1; backend dry_run always, and mujoco
+when offscreen EGL rendering works here. Screenshots go to /tmp/web_check/ for a human look.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+from tests.web.conftest import free_port, library_overrides
+
+pytestmark = pytest.mark.slow
+playwright_api = pytest.importorskip("playwright.sync_api")
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+SHOTS = Path("/tmp/web_check")
+expect = playwright_api.expect
+
+
+def egl_works() -> bool:
+    probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8)"
+    env = {**os.environ, "MUJOCO_GL": "egl"}
+    return subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, timeout=120, check=False).returncode == 0
+
+
+def backends() -> list:
+    mujoco = pytest.param("mujoco", marks=pytest.mark.skipif(not egl_works(), reason="no offscreen EGL here"))
+    return ["dry_run", mujoco]
+
+
+def get_json(url: str) -> dict:
+    with urllib.request.urlopen(url, timeout=5) as response:
+        return json.load(response)
+
+
+@pytest.fixture(scope="module", params=backends())
+def server(request, tmp_path_factory):
+    import shutil
+
+    from tests.web.conftest import SHIPPED
+
+    if not Path(CHROMIUM).exists():
+        pytest.skip("Debian chromium is not installed")
+    root = tmp_path_factory.mktemp(f"serve_{request.param}")
+    library = root / "library" / "g1"
+    shutil.copytree(SHIPPED, library, ignore=shutil.ignore_patterns(".backup"))
+    port = free_port()
+    with open(root / "server.log", "w") as log:
+        yield from _run_server(request.param, port, library, root, log)
+
+
+def _run_server(backend: str, port: int, library: Path, root: Path, log):
+    process = subprocess.Popen(
+        [sys.executable, "-m", "emopose", "+experiment=serve", f"backend={backend}", "planner=keyword",
+         f"serve.port={port}", "run.record=false", f"hydra.run.dir={root}/run", *library_overrides(library)],
+        stdout=log, stderr=subprocess.STDOUT, env={**os.environ, "MUJOCO_GL": "egl", "EMOPOSE_TOKEN": ""})
+    base = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 180
+    while time.monotonic() < deadline:
+        if process.poll() is not None:
+            pytest.fail(f"server exited early:\n{(root / 'server.log').read_text()[-3000:]}")
+        try:
+            get_json(f"{base}/api/health")
+            break
+        except OSError:
+            time.sleep(0.3)
+    else:
+        process.kill()
+        pytest.fail("server did not come up in 180 s")
+    yield {"base": base, "backend": backend, "library": library, "root": root}
+    process.send_signal(signal.SIGINT)  # a graceful stop: the job writes results.json
+    try:
+        process.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        process.kill()
+    assert (root / "run" / "results.json").is_file()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with playwright_api.sync_playwright() as p:
+        launched = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield launched
+        launched.close()
+
+
+@pytest.fixture
+def page(browser, server):
+    context = browser.new_context(viewport={"width": 1400, "height": 900})
+    page = context.new_page()
+    foreign, errors = [], []
+    page.on("request", lambda r: None if r.url.startswith((server["base"], "data:", "blob:")) else foreign.append(r.url))
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    yield page
+    context.close()
+    assert not foreign, f"the page fetched from outside the server: {foreign}"
+    assert not errors, f"JavaScript errors: {errors}"
+
+
+def live_view(page, server):
+    return page.locator("#sim" if server["backend"] == "mujoco" else "#stick")
+
+
+def test_chat_reply_cues_and_a_moving_simulation_view(page, server):
+    page.goto(server["base"] + "/")
+    expect(page.locator("#badges")).to_contain_text(server["backend"])
+    expect(page.locator("#badges")).to_contain_text("keyword")
+    if server["backend"] == "mujoco":
+        page.wait_for_function("Number(document.querySelector('#sim').dataset.frames || 0) >= 3", timeout=30_000)
+    page.fill("#say-text", "Welcome to the lab! The robot arm is over there, it is really important.")
+    page.click("#send")
+    bubble = page.locator(".bubble.robot").last
+    expect(bubble).to_contain_text("The robot arm is over there")
+    expect(bubble.locator(".cue")).to_have_count(3)
+    expect(bubble.locator(".cue.fired").first).to_be_visible(timeout=10_000)  # highlighted at its release
+    expect(bubble.locator("mark.fired").first).to_be_visible()
+    expect(page.locator("#seq-state")).not_to_have_text("idle", timeout=10_000)
+    view = live_view(page, server)
+    first = view.screenshot()
+    page.wait_for_timeout(700)
+    assert view.screenshot() != first, "the simulation view did not change while a gesture ran"
+    expect(bubble.locator(".cue.fired")).to_have_count(3, timeout=15_000)
+    SHOTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(SHOTS / f"chat_{server['backend']}.png"))
+
+
+def test_interrupt_clears_the_queue(page, server):
+    page.goto(server["base"] + "/")
+    expect(page.locator("#connection")).to_have_text("live")
+    page.fill("#say-text", "Welcome! Look over there. This is really important. I am not sure, maybe.")
+    page.click("#send")
+    expect(page.locator("#seq-queue li").first).not_to_have_text("empty", timeout=10_000)
+    page.click("#interrupt")
+    expect(page.locator("#seq-queue li")).to_have_text(["empty"], timeout=5_000)
+    expect(page.locator(".bubble.robot").last.locator(".cue.cancelled").first).to_be_visible()
+    status = get_json(server["base"] + "/api/status")
+    assert status["pending"] == []
+
+
+def test_studio_variant_is_saved_and_the_next_message_resolves_to_it(page, server):
+    name = f"wave_{server['backend']}_variant"
+    page.goto(server["base"] + "/studio")
+    expect(page.locator("#verdict")).to_have_text("ready to save", timeout=15_000)
+    rendering = get_json(server["base"] + "/api/info")["render"]
+    expect(page.locator("#preview-caption")).to_contain_text("MuJoCo" if rendering else "stick", timeout=60_000)
+    page.fill("#name", name)
+    page.select_option("#class", "welcoming")
+    page.fill("#description", "a wide raised wave made in the browser test")
+    elbow = page.locator('#sliders input[type=number][aria-label="right_elbow_joint"]')
+    elbow.fill("0.5")
+    elbow.dispatch_event("change")
+    expect(page.locator("#keyframes li.selected")).to_contain_text("0.50")
+    expect(page.locator("#verdict")).to_have_text("ready to save", timeout=10_000)
+    page.click("#save")
+    expect(page.locator("#save-result")).to_contain_text(f"saved {name}", timeout=10_000)
+    assert (server["library"] / f"{name}.yaml").is_file()
+    page.click("#perform")
+    expect(page.locator("#perform-result")).to_contain_text(f"→ {name} (exact)", timeout=10_000)
+    SHOTS.mkdir(exist_ok=True)
+    page.screenshot(path=str(SHOTS / f"studio_{server['backend']}.png"), full_page=True)
+
+    page.goto(server["base"] + "/")  # the chat page: ask for the new variant by name
+    expect(page.locator(f'#gesture-name option[value="{name}"]')).to_have_count(1, timeout=10_000)
+    page.select_option("#gesture-name", name)
+    page.click("#gesture-go")
+    cue = page.locator(".bubble.robot").last.locator(".cue")
+    expect(cue.locator(".name")).to_have_text(name, timeout=10_000)
+    expect(cue).to_contain_text("exact")

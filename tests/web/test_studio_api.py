@@ -1,0 +1,129 @@
+"""Pose Studio over the API: checks before saving, the save round trip, the live library, speech.
+
+A motion saved through the API is resolvable and executable on the very next request, with no
+restart: MotionLibrary.save reloads and the resolver and guide read the live library.
+"""
+
+from __future__ import annotations
+
+import pytest
+from fastapi.testclient import TestClient
+
+from tests.web.conftest import LOCAL, SHIPPED
+from tests.web.test_api import motion_body, wait_for
+
+
+# -- Pose Studio -----------------------------------------------------------------------------------
+def test_studio_check_builds_the_50hz_trajectory_with_the_duration_rule(client):
+    library = client.get("/api/library").json()
+    rest = library["neutral_pose"]
+    raised = list(rest)
+    raised[7] = -0.9
+    report = client.post("/api/studio/check", json={"keyframes": [rest, raised, raised, rest]}).json()
+    assert report["default_duration"] == pytest.approx(1.0)  # clip(0.3 * 3, 1, 5)
+    assert len(report["samples"]) == 51 and len(report["samples"][0]) == 14 and report["dt"] == 0.02
+    assert [c["intensity"] for c in report["levels"]] == [1, 2, 3, 4, 5] and report["can_save"]
+    timed = client.post("/api/studio/check", json={"keyframes": [rest, raised, rest], "duration": 2.5}).json()
+    assert timed["explicit_duration"] and len(timed["samples"]) == 126
+    assert len(report["stick"]) >= 10 and set(report["stick"][0]) == {"front", "side"}
+
+
+def test_studio_preview_without_mujoco_falls_back_to_the_stick_figure(client):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    preview = client.post("/api/studio/preview", json={"keyframes": [rest] * 3, "camera": "head", "frames": 5}).json()
+    assert preview["frames"] == [] and preview["fallback"] == "stick" and len(preview["times"]) == 5
+    assert client.post("/api/studio/preview", json={"keyframes": [rest] * 3, "camera": "../x"}).status_code == 422
+
+
+def test_studio_refuses_a_colliding_or_out_of_limit_motion(client, library_copy):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    inward = list(rest)
+    inward[7], inward[8] = -0.5, 0.9  # right upper arm swung into the torso
+    body = {"name": "hug_torso", "class": "comforting", "description": "collides", "keyframes": [rest, inward, rest]}
+    report = client.post("/api/studio/check", json={"keyframes": body["keyframes"]}).json()
+    assert not report["can_save"] and "self-collision" in report["problems"][0]
+    refused = client.post("/api/library", json=body)
+    assert refused.status_code == 422 and "self-collision" in refused.json()["error"]
+    beyond = list(rest)
+    beyond[3] = 3.0  # left elbow past its 2.0944 rad limit
+    refused = client.post("/api/library", json={**body, "keyframes": [rest, beyond, rest]})
+    assert refused.status_code == 422 and "left_elbow_joint" in refused.json()["error"]
+    assert not (library_copy / "hug_torso.yaml").exists()
+
+
+def test_save_round_trip_with_backup_and_overwrite(client, library_copy):
+    shipped_before = sorted(p.name for p in SHIPPED.iterdir())
+    body = motion_body(client, "wave_test_variant")
+    saved = client.post("/api/library", json=body)
+    assert saved.status_code == 201, saved.text
+    assert saved.json()["file"] == "g1/wave_test_variant.yaml" and saved.json()["backup"] is None
+    assert (library_copy / "wave_test_variant.yaml").is_file()
+    assert client.get("/api/library/wave_test_variant").json()["keyframes"] == body["keyframes"]
+
+    again = client.post("/api/library", json=body)
+    assert again.status_code == 409 and "overwrite" in again.json()["error"]
+    body["keyframes"][1][13] += 0.05
+    replaced = client.post("/api/library", json={**body, "overwrite": True})
+    assert replaced.status_code == 201 and replaced.json()["replaced"]
+    backup = library_copy.parent / replaced.json()["backup"]
+    assert backup.is_file() and "wave_test_variant" in backup.read_text()
+    assert not list(library_copy.glob(".*.tmp"))  # the atomic write left no temporary file behind
+    assert client.get("/api/library/wave_test_variant").json()["keyframes"] == body["keyframes"]
+    assert sorted(p.name for p in SHIPPED.iterdir()) == shipped_before  # the shipped library is untouched
+
+
+def test_a_saved_variant_resolves_and_runs_on_the_next_request(client):
+    from emopose.planners.guide import library_guide
+
+    version = client.get("/api/library").json()["version"]
+    assert client.post("/api/resolve", json={"class": "welcoming", "variant": "wave_test_variant"}).json()["rule"] \
+        == "class_default"
+    assert client.post("/api/library", json=motion_body(client, "wave_test_variant")).status_code == 201
+    resolved = client.post("/api/resolve", json={"class": "welcoming", "variant": "wave_test_variant"}).json()
+    assert resolved["resolved"] == "wave_test_variant" and resolved["rule"] == "exact"
+    assert resolved["library_version"] == version + 1
+    ctx = client.app.state.session.ctx
+    assert "wave_test_variant" in library_guide(ctx.library)  # the planners' guide, regenerated
+    turn = client.post("/api/gesture", json={"name": "wave_test_variant"}).json()
+    assert turn["cues"][0]["resolved"] == "wave_test_variant" and turn["cues"][0]["rule"] == "exact"
+    assert wait_for(lambda: any(e.kind == "started" and e.name == "wave_test_variant" for e in ctx.sequencer.events))
+
+
+# -- speech ----------------------------------------------------------------------------------------
+def test_audio_is_served_only_for_known_turns(client):
+    assert client.get("/api/audio/999").status_code == 404
+    assert client.get("/api/audio/..%2F..%2Fetc%2Fpasswd").status_code in (404, 422)
+
+
+def test_spoken_reply_audio_is_served(serve_app):
+    import shutil as _shutil
+
+    if _shutil.which("espeak-ng") is None and not list(__import__("pathlib").Path("/usr/lib").rglob("libespeak-ng.so.1")):
+        pytest.skip("espeak-ng is not installed")
+    app, _, _ = serve_app("tts=espeak")
+    with TestClient(app, base_url=LOCAL) as client:
+        turn = client.post("/api/say", json={"text": "Hello there!"}).json()
+        assert turn["speech"]["audio"] and not turn["speech"]["estimated"]
+        audio = client.get(turn["speech"]["audio"])
+    assert audio.status_code == 200 and audio.content[:4] == b"RIFF"
+
+
+class FakeASR:
+    name = "fake"
+
+    def utterance(self, text=None, audio=None):
+        return "welcome to the lab" if audio and open(audio, "rb").read() == b"fake-webm" else ""
+
+
+def test_microphone_upload_needs_an_asr(serve_app):
+    app, session, _ = serve_app()
+    with TestClient(app, base_url=LOCAL) as client:
+        headers = {"Content-Type": "audio/webm"}
+        assert client.post("/api/utterance/audio", content=b"fake-webm", headers=headers).status_code == 409
+        session.asr = FakeASR()
+        assert client.get("/api/info").json()["asr"] is True
+        turn = client.post("/api/utterance/audio", content=b"fake-webm", headers=headers).json()
+        assert turn["utterance"] == "welcome to the lab" and turn["cues"][0]["class"] == "welcoming"
+        assert client.post("/api/utterance/audio", content=b"x", headers={"Content-Type": "video/x-evil"}).status_code == 415
+        huge = client.post("/api/utterance/audio", content=b"0" * (9 * 1024 * 1024), headers=headers)
+        assert huge.status_code == 413
