@@ -11,7 +11,7 @@ from emopose.build import ConfigError, build_context, make
 from emopose.config import CONFIG_DIR
 
 HEAVY_PLANNERS = {"local", "sbert_centroids"}  # load MiniLM: covered by the slow planner tests
-GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name != "experiment")
+GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name not in ("experiment", "reset"))
 
 
 def options(group: str) -> list[str]:

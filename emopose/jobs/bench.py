@@ -1,0 +1,97 @@
+"""+experiment=bench_easy|bench_medium|bench_hard|bench_all: top-1 accuracy on EmoPose-Bench.
+
+Top-1 is the first planned class (paper protocol). Writes results.json (method, n, accuracy per tier
+and overall as {mean, sd} over passes in %, predictions [{id, label, pred, tier, pass}], fallbacks,
+failures, latency mean/p95), results.md (ours beside the paper) and confusion.png (one panel per tier).
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+
+from emopose.bench.confusion import ABBREVIATIONS, ConfusionPanel, confusion_counts, plot_confusion
+from emopose.bench.metrics import accuracy, by_pass, tier_accuracy
+from emopose.bench.suites import TIERS, load_bench
+from emopose.bench.tables import comparison_markdown, fmt
+from emopose.context import RunContext
+from emopose.jobs.report import write_results
+from emopose.jobs.suite_planning import latency_summary, plan_suite, resolve_passes
+from emopose.planners.base import PlanRequest
+
+
+@dataclass
+class BenchJob:
+    path: str
+    tiers: list[str] = field(default_factory=lambda: list(TIERS))
+    passes: int | None = None  # None: 5 for a sampled planner, 1 otherwise
+    chunk_size: int = 64
+    progress: bool = True
+    confusion: bool = True
+
+    def __call__(self, ctx: RunContext) -> dict:
+        unknown = sorted(set(self.tiers) - set(TIERS))
+        if unknown:
+            raise ValueError(f"job.tiers has unknown tiers {unknown}; allowed: {list(TIERS)}")
+        items = load_bench(self.path, self.tiers)
+        if not items:
+            raise ValueError(f"{self.path} has no items of tiers {self.tiers} (bench.path)")
+        planner, passes = ctx.planner, resolve_passes(self.passes, ctx.planner)
+        requests = [PlanRequest(utterance=i.text) for i in items]
+        predictions, planned_all = [], []
+        started = time.perf_counter()
+        for p in range(passes):
+            planned = plan_suite(planner, requests, f"{planner.name} bench pass {p + 1}/{passes}",
+                                 self.chunk_size, self.progress)
+            planned_all.extend(planned)
+            for item, outcome in zip(items, planned):
+                row = {"id": item.id, "label": item.label, "pred": outcome.top_class, "tier": item.tier, "pass": p}
+                if outcome.error is not None:
+                    row["error"] = outcome.error
+                predictions.append(row)
+        results = {
+            "kind": "bench",
+            "suite": str(self.path),
+            "method": planner.name,
+            "tiers": list(self.tiers),
+            "n": len(items),
+            "passes": passes,
+            "accuracy": tier_accuracy(predictions, TIERS),
+            "per_pass": [{t: accuracy((q["label"], q["pred"]) for q in preds if q["tier"] == t)
+                          for t in self.tiers} for preds in by_pass(predictions).values()],
+            "fallbacks": sum(i.fallback for i in planned_all),
+            "failures": sum(i.plan is None for i in planned_all),
+            "latency_s": latency_summary(planned_all),
+            "wall_s": time.perf_counter() - started,
+            "predictions": predictions,
+        }
+        markdown = comparison_markdown([results]) + "\n" + leading_confusions(predictions, self.tiers)
+        if self.confusion:
+            results["confusion_png"] = str(self.write_confusion(ctx, predictions, results))
+            markdown += f"\nConfusion matrices: {results['confusion_png']}\n"
+        write_results(ctx.run_dir, results, markdown)
+        print(markdown)
+        return results
+
+    def write_confusion(self, ctx: RunContext, predictions: list[dict], results: dict):
+        panels = []
+        for tier in [t for t in TIERS if t in self.tiers]:
+            counts, failed = confusion_counts([(p["label"], p["pred"]) for p in predictions if p["tier"] == tier])
+            title = f"{tier.capitalize()} ({counts.sum() + failed} decisions): {fmt(results['accuracy'][tier])}%"
+            panels.append(ConfusionPanel(title, counts, failed))
+        name = f"{results['method']}, {results['passes']} pass(es), pooled counts"
+        return plot_confusion(panels, ctx.run_dir / "confusion.png", suptitle=name)
+
+
+def leading_confusions(predictions: list[dict], tiers: list[str], top: int = 5) -> str:
+    """The most frequent label -> pred errors per tier, pooled over passes (as the paper discusses)."""
+    lines = ["Leading confusions (annotated -> predicted, pooled count / annotated items):"]
+    for tier in [t for t in TIERS if t in tiers]:
+        preds = [p for p in predictions if p["tier"] == tier]
+        support = Counter(p["label"] for p in preds)
+        errors = Counter((p["label"], p["pred"]) for p in preds if p["pred"] != p["label"])
+        shown = ", ".join(f"{ABBREVIATIONS[a]}->{ABBREVIATIONS.get(b, 'fail')} {n}/{support[a]}"
+                          for (a, b), n in errors.most_common(top))
+        lines.append(f"- {tier}: {shown or 'none'}")
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,69 @@
+"""+experiment=context_ablation: paired dialogue-history ablation on the context suite.
+
+Every item is planned twice per pass with the same planner: with its preceding dialogue turns and with
+them removed. Accuracy (%) with and without history and the paired gain are computed per pass and
+reported as mean and sample SD over passes (paper Table extensions), with pooled discordant pairs.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from emopose.bench.metrics import paired_context_accuracy
+from emopose.bench.suites import load_context
+from emopose.bench.tables import comparison_markdown
+from emopose.context import RunContext
+from emopose.jobs.report import write_results
+from emopose.jobs.suite_planning import latency_summary, plan_suite, resolve_passes
+from emopose.planners.base import PlanRequest
+
+
+@dataclass
+class ContextAblationJob:
+    path: str
+    passes: int | None = None  # None: 5 for a sampled planner, 1 otherwise
+    chunk_size: int = 64
+    progress: bool = True
+
+    def __call__(self, ctx: RunContext) -> dict:
+        items = load_context(self.path)
+        if not items:
+            raise ValueError(f"{self.path} has no items (bench.path)")
+        planner, passes = ctx.planner, resolve_passes(self.passes, ctx.planner)
+        with_history = [PlanRequest(utterance=i.text, history=i.history) for i in items]
+        without_history = [PlanRequest(utterance=i.text) for i in items]
+        predictions, planned_all = [], []
+        started = time.perf_counter()
+        for p in range(passes):
+            tag = f"{planner.name} context pass {p + 1}/{passes}"
+            planned_with = plan_suite(planner, with_history, f"{tag} with history", self.chunk_size, self.progress)
+            planned_without = plan_suite(planner, without_history, f"{tag} without", self.chunk_size,
+                                         self.progress)
+            planned_all += planned_with + planned_without
+            for item, a, b in zip(items, planned_with, planned_without):
+                predictions.append({"id": item.id, "label": item.label, "pred_with": a.top_class,
+                                    "pred_without": b.top_class, "history_turns": len(item.history), "pass": p})
+        paired = paired_context_accuracy(predictions)
+        results = {
+            "kind": "context_ablation",
+            "suite": str(self.path),
+            "method": planner.name,
+            "n": len(items),
+            "passes": passes,
+            "accuracy": {k: paired[k] for k in ("with_history", "without_history", "gain")},
+            "per_pass": paired["per_pass"],
+            "discordant": paired["discordant"],
+            "fallbacks": sum(i.fallback for i in planned_all),
+            "failures": sum(i.plan is None for i in planned_all),
+            "latency_s": latency_summary(planned_all),
+            "wall_s": time.perf_counter() - started,
+            "predictions": predictions,
+        }
+        d = paired["discordant"]
+        markdown = comparison_markdown([results]) + (
+            f"\nDiscordant pairs (pooled over passes): right only with history {d['only_with_history']}, "
+            f"right only without {d['only_without_history']}.\n")
+        write_results(ctx.run_dir, results, markdown)
+        print(markdown)
+        return results

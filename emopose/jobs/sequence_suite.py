@@ -1,0 +1,85 @@
+"""+experiment=sequence_suite: ordered multi-action planning on the sequence suite.
+
+Each item's planned records (class, trigger, variant, in order) are scored against the annotated
+labels, anchors and variants with emopose.bench.sequence_metrics (definitions there). Rates are per
+pass, reported as mean and sample SD over passes; segmentation counts are pooled over passes.
+Annotated variants are checked against the live library before planning (check_variants).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from emopose.bench.metrics import aggregate_passes
+from emopose.bench.sequence_metrics import SequencePrediction, suite_scores
+from emopose.bench.suites import load_sequence
+from emopose.bench.tables import comparison_markdown
+from emopose.context import RunContext
+from emopose.jobs.report import write_results
+from emopose.jobs.suite_planning import PlannedItem, latency_summary, plan_suite, resolve_passes
+from emopose.planners.base import PlanRequest
+
+COUNT_KEYS = ("over", "under", "failed")
+
+
+def as_prediction(outcome: PlannedItem) -> SequencePrediction:
+    if outcome.plan is None:
+        return SequencePrediction(classes=None)
+    records = outcome.plan.records
+    return SequencePrediction(tuple(r.cls for r in records), tuple(r.trigger for r in records),
+                              tuple(r.variant for r in records))
+
+
+@dataclass
+class SequenceSuiteJob:
+    path: str
+    passes: int | None = None  # None: 5 for a sampled planner, 1 otherwise
+    check_variants: bool = True
+    chunk_size: int = 64
+    progress: bool = True
+
+    def __call__(self, ctx: RunContext) -> dict:
+        entries = ctx.library.snapshot.entries
+        variant_classes = {name: e.cls for name, e in entries.items()} if self.check_variants else None
+        items = load_sequence(self.path, variant_classes)
+        if not items:
+            raise ValueError(f"{self.path} has no items (bench.path)")
+        planner, passes = ctx.planner, resolve_passes(self.passes, ctx.planner)
+        requests = [PlanRequest(utterance=i.text) for i in items]
+        per_pass, predictions, planned_all = [], [], []
+        started = time.perf_counter()
+        for p in range(passes):
+            planned = plan_suite(planner, requests, f"{planner.name} sequence pass {p + 1}/{passes}",
+                                 self.chunk_size, self.progress)
+            planned_all.extend(planned)
+            preds = [as_prediction(o) for o in planned]
+            per_pass.append(suite_scores(items, preds))
+            for item, pred in zip(items, preds):
+                predictions.append({"id": item.id, "labels": list(item.labels), "pred": None if pred.classes is None
+                                    else list(pred.classes), "triggers": list(pred.triggers),
+                                    "variants": list(pred.variants), "pass": p})
+        rates = [{k: v for k, v in scores.items() if k not in COUNT_KEYS} for scores in per_pass]
+        results = {
+            "kind": "sequence_suite",
+            "suite": str(self.path),
+            "method": planner.name,
+            "n": len(items),
+            "passes": passes,
+            "metrics": aggregate_passes(rates),
+            "segmentation": {f"{k}_total": sum(s[k] for s in per_pass) for k in COUNT_KEYS}
+            | {f"{k}_per_pass": [s[k] for s in per_pass] for k in COUNT_KEYS},
+            "per_pass": per_pass,
+            "fallbacks": sum(i.fallback for i in planned_all),
+            "failures": sum(i.plan is None for i in planned_all),
+            "latency_s": latency_summary(planned_all),
+            "wall_s": time.perf_counter() - started,
+            "predictions": predictions,
+        }
+        seg = results["segmentation"]
+        markdown = comparison_markdown([results]) + (
+            f"\nPooled over {passes} pass(es) x {len(items)} plans: {seg['over_total']} over-segmented, "
+            f"{seg['under_total']} under-segmented, {seg['failed_total']} failed.\n")
+        write_results(ctx.run_dir, results, markdown)
+        print(markdown)
+        return results

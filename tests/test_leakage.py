@@ -1,0 +1,72 @@
+"""THE LEAKAGE TEST (spec, "Leakage rule").
+
+No suite item (benchmark, context, sequence) may near-duplicate an in-context demonstration
+(prompts/demonstrations.jsonl) or a training item (experiments/train/*.jsonl), and no suite may hold
+internal near-duplicates. Near-duplicate: equal normalised text, word-3-gram Jaccard >= 0.5, or >= 0.7
+3-gram containment for texts of >= 4 words (emopose.bench.near_duplicates; an inverted index over
+3-grams keeps this to seconds). Files not written yet are skipped, by name.
+"""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from emopose.bench.near_duplicates import Text, cross_duplicates, internal_duplicates
+from emopose.config import PROJECT_ROOT
+
+SUITES = {
+    "bench": PROJECT_ROOT / "experiments/bench/emopose_bench.jsonl",
+    "context": PROJECT_ROOT / "experiments/context/context_suite.jsonl",
+    "sequence": PROJECT_ROOT / "experiments/sequence/sequence_suite.jsonl",
+}
+DEMONSTRATIONS = PROJECT_ROOT / "prompts/demonstrations.jsonl"
+TRAIN_DIR = PROJECT_ROOT / "experiments/train"
+SHOWN = 15
+
+
+def texts_of(path: Path, prefix: str) -> list[Text]:
+    rows = [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line.strip()]
+    return [Text.of(f"{prefix}:{row.get('id', k)}", row["text"]) for k, row in enumerate(rows)]
+
+
+def suite_texts(name: str) -> list[Text]:
+    path = SUITES[name]
+    if not path.is_file():
+        pytest.skip(f"{path.relative_to(PROJECT_ROOT)} not written yet")
+    return texts_of(path, name)
+
+
+def report(pairs) -> str:
+    lines = [str(p) for p in pairs[:SHOWN]]
+    more = f"\n... and {len(pairs) - SHOWN} more" if len(pairs) > SHOWN else ""
+    return f"{len(pairs)} near-duplicate pair(s):\n" + "\n".join(lines) + more
+
+
+@pytest.mark.parametrize("suite", sorted(SUITES))
+def test_no_internal_near_duplicates(suite):
+    pairs = internal_duplicates(suite_texts(suite))
+    if pairs:
+        pytest.fail(report(pairs), pytrace=False)
+
+
+@pytest.mark.parametrize("suite", sorted(SUITES))
+def test_no_suite_item_near_duplicates_a_demonstration(suite):
+    texts = suite_texts(suite)
+    if not DEMONSTRATIONS.is_file():
+        pytest.skip("prompts/demonstrations.jsonl not written yet")
+    pairs = cross_duplicates(texts, texts_of(DEMONSTRATIONS, "demo"))
+    if pairs:
+        pytest.fail(report(pairs), pytrace=False)
+
+
+@pytest.mark.parametrize("suite", sorted(SUITES))
+def test_no_suite_item_near_duplicates_a_training_item(suite):
+    texts = suite_texts(suite)
+    train_files = sorted(TRAIN_DIR.glob("*.jsonl"))
+    if not train_files:
+        pytest.skip("experiments/train/*.jsonl not written yet")
+    training = [t for f in train_files for t in texts_of(f, f"train/{f.stem}")]
+    pairs = cross_duplicates(texts, training)
+    if pairs:
+        pytest.fail(report(pairs), pytrace=False)
