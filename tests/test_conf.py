@@ -11,7 +11,8 @@ from emopose.build import ConfigError, build_context, make
 from emopose.config import CONFIG_DIR
 
 HEAVY_PLANNERS = {"local", "sbert_centroids"}  # load MiniLM: covered by the slow planner tests
-GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name not in ("experiment", "reset"))
+# reset and tour are not in the primary defaults (experiments add them); tour files: tests/tour/test_scenario.py
+GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name not in ("experiment", "reset", "tour"))
 
 
 def options(group: str) -> list[str]:

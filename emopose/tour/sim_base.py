@@ -1,0 +1,88 @@
+"""The MuJoCo planar base (backend.planar_base=true) as a MobileBase, with dead-reckoning odometry.
+
+Odometry integrates the base's body-frame velocity each control period, as leg odometry does,
+with optional seeded Gaussian noise on the velocities, so it drifts from the simulated truth the
+way a real robot's does; `true_pose()` is the simulator's ground truth, used only to score the tour.
+Call place() and the odometry before the control loop runs on another thread (the tour drives the
+simulation on its own thread).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from emopose.tour.geometry import Pose2D, wrap_angle
+
+BASE_JOINTS = ("base_x", "base_y", "base_yaw")
+
+
+class MujocoBase:
+    def __init__(self, backend, velocity_std: float = 0.0, yaw_rate_std: float = 0.0, seed: int = 0,
+                 rest_speed: float = 0.01) -> None:
+        if backend.data is None:
+            raise RuntimeError("MujocoBase needs a connected mujoco backend (ctx.open() first)")
+        if not backend.planar_base:
+            raise ValueError("the tour in simulation needs backend.planar_base=true (x, y, yaw base joints)")
+        self.backend = backend
+        model = backend.model
+        self._qadr = [model.joint(n).qposadr[0] for n in BASE_JOINTS]
+        self._dadr = [model.joint(n).dofadr[0] for n in BASE_JOINTS]
+        self.velocity_std, self.yaw_rate_std = velocity_std, yaw_rate_std
+        self.rest_speed = rest_speed
+        self._rng = np.random.default_rng(seed)
+        self._odom = self.true_pose()
+        self.travelled_m = 0.0
+
+    # -- ground truth ------------------------------------------------------------------------
+    def true_pose(self) -> Pose2D:
+        x, y, yaw = (float(self.backend.data.qpos[a]) for a in self._qadr)
+        return Pose2D(x, y, wrap_angle(yaw))
+
+    def true_velocity(self) -> tuple[float, float, float]:
+        """Body-frame (vx, vy, wz) of the simulated base."""
+        vx_w, vy_w, wz = (float(self.backend.data.qvel[a]) for a in self._dadr)
+        yaw = float(self.backend.data.qpos[self._qadr[2]])
+        c, s = math.cos(yaw), math.sin(yaw)
+        return c * vx_w + s * vy_w, -s * vx_w + c * vy_w, wz
+
+    def place(self, pose: Pose2D) -> None:
+        """Teleport the base (at rest) and reset odometry to it: the start of a tour or a trial."""
+        import mujoco
+
+        data = self.backend.data
+        for adr, value in zip(self._qadr, (pose.x, pose.y, pose.yaw)):
+            data.qpos[adr] = value
+        for adr in self._dadr:
+            data.qvel[adr] = 0.0
+        mujoco.mj_forward(self.backend.model, data)
+        self._odom = pose
+
+    # -- MobileBase ----------------------------------------------------------------------------
+    def odometry(self) -> Pose2D:
+        return self._odom
+
+    def command(self, vx: float, wz: float) -> None:
+        self.backend.set_base_velocity(float(vx), 0.0, float(wz))
+
+    def stop(self) -> None:
+        self.backend.set_base_velocity(0.0, 0.0, 0.0)
+
+    def moving(self) -> bool:
+        vx, vy, wz = self.true_velocity()
+        return math.hypot(vx, vy) > self.rest_speed or abs(wz) > 2 * self.rest_speed
+
+    def after_tick(self, dt: float) -> None:
+        vx, vy, wz = self.true_velocity()
+        if self.velocity_std or self.yaw_rate_std:
+            moving = math.hypot(vx, vy) > 1e-3 or abs(wz) > 1e-3  # no drift while standing still
+            if moving:
+                vx += self._rng.normal(0.0, self.velocity_std)
+                vy += self._rng.normal(0.0, self.velocity_std)
+                wz += self._rng.normal(0.0, self.yaw_rate_std)
+        o = self._odom
+        yaw_mid = o.yaw + 0.5 * wz * dt  # midpoint heading: exact for constant-curvature arcs
+        c, s = math.cos(yaw_mid), math.sin(yaw_mid)
+        self._odom = Pose2D(o.x + (c * vx - s * vy) * dt, o.y + (s * vx + c * vy) * dt, wrap_angle(o.yaw + wz * dt))
+        self.travelled_m += math.hypot(vx, vy) * dt

@@ -1,0 +1,130 @@
+"""Saying things on the tour: plan a line into gestures, speak it, and wait for it to finish.
+
+perform() is ctx.run_turn's flow without its blocking dispatch: the tour pipeline (conf/pipeline/
+tour.yaml) queues the gestures against the speech start and returns, and finish() then advances the
+world until the speech has ended and the arms have settled, polling for a visitor's question, which
+cuts the line short. speak_only() is speech without gestures (lines said while walking).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from emopose.pipeline import Turn
+from emopose.sequencer import State
+from emopose.speech.clip import SpeechClip
+from emopose.tour.interruptions import Question
+from emopose.tour.world import TourWorld
+
+_SENTENCE_END = re.compile(r"[.!?]+[\"')\]]*\s+")
+# The parse stage keeps at most 200 characters of a model's reply (stages/parse.py, _text), so a
+# longer line is planned and spoken in chunks of whole sentences.
+LINE_LIMIT = 200
+
+
+def sentence_chunks(text: str, limit: int = LINE_LIMIT) -> list[str]:
+    """Whole sentences packed into pieces of at most `limit` characters (a longer sentence is cut at words)."""
+    sentences, start = [], 0
+    for match in _SENTENCE_END.finditer(text):
+        sentences.append(text[start:match.end()].strip())
+        start = match.end()
+    sentences.append(text[start:].strip())
+    chunks: list[str] = []
+    for sentence in filter(None, sentences):
+        while len(sentence) > limit:  # rare: one very long sentence
+            cut = sentence.rfind(" ", 0, limit)
+            cut = cut if cut > 0 else limit
+            chunks.append(sentence[:cut].strip())
+            sentence = sentence[cut:].strip()
+        if chunks and len(chunks[-1]) + 1 + len(sentence) <= limit:
+            chunks[-1] = f"{chunks[-1]} {sentence}"
+        else:
+            chunks.append(sentence)
+    return chunks
+
+
+@dataclass
+class Line:
+    kind: str  # narration | answer | approach | closing | abort
+    text: str  # what was said
+    speech: SpeechClip
+    speech_start: float
+    turn: Turn | None = None
+    stopped_at_s: float | None = None  # into the speech, when a question cut it short
+
+    def remaining(self) -> str:
+        """The text from the sentence that was being spoken when the line was cut short."""
+        if self.stopped_at_s is None or self.stopped_at_s >= self.speech.duration_s:
+            return ""
+        pos = _char_at(self.speech, self.stopped_at_s)
+        starts = [0] + [m.end() for m in _SENTENCE_END.finditer(self.text) if m.end() <= pos]
+        return self.text[starts[-1]:].strip()
+
+
+def _char_at(speech: SpeechClip, t: float) -> int:
+    spoken = [w for w in speech.words if w.start_s <= t]
+    if spoken:
+        return spoken[-1].char_start
+    return int(len(speech.text) * t / max(speech.duration_s, 1e-9))  # the anchor rule's linear map
+
+
+class TourVoice:
+    def __init__(self, world: TourWorld) -> None:
+        self.world, self.ctx = world, world.ctx
+
+    def perform(self, utterance: str, kind: str, image: bytes | None = None, planner=None,
+                extra_history: tuple[dict, ...] = ()) -> Line:
+        """Plan `utterance` (with the dialogue so far) and start saying it with its gestures."""
+        ctx = self.ctx
+        turn = ctx.new_turn(utterance, image)
+        if extra_history:
+            turn.request = replace(turn.request, history=turn.request.history + extra_history)
+        if planner is None:
+            ctx.plan_turn(turn)
+        else:
+            turn.planner_output = planner.plan(turn.request)
+            turn.stage_s["planner"] = turn.planner_output.latency_s
+        ctx.pipeline.run(turn, ctx)
+        ctx.record_turn(turn)
+        submitted = turn.values.get("submitted")
+        start = submitted.speech_start if submitted is not None else ctx.clock.now()
+        return Line(kind, turn.plan.reply, turn.schedule.speech, start, turn)
+
+    def speak_only(self, text: str, kind: str) -> Line:
+        speech = self.ctx.speech.synthesize(text)
+        start = self.ctx.start_speech(speech)
+        self.world.record("/tour/speech", {"kind": kind, "text": text, "duration_s": speech.duration_s})
+        return Line(kind, text, speech, start)
+
+    def finish(self, line: Line, poll: Callable[[float], Question | None] | None = None,
+               wait_for_gestures: bool = True, timeout_s: float = 120.0) -> Question | None:
+        """Advance until the line is spoken (and its gestures done); a polled question stops it early."""
+        sequencer, end = self.ctx.sequencer, line.speech_start + line.speech.duration_s
+        deadline = self.world.now() + timeout_s
+        while self.world.now() < deadline:
+            now = self.world.now()
+            if now >= end and (not wait_for_gestures or sequencer.settled()):
+                return None
+            question = poll(now - line.speech_start) if poll is not None else None
+            if question is not None:
+                line.stopped_at_s = now - line.speech_start
+                self.cut_short()
+                return question
+            self.world.advance()
+        return None
+
+    def cut_short(self) -> None:
+        """Stop talking and clear pending gestures, blending from the current pose toward neutral."""
+        player = self.ctx.player
+        if player is not None and hasattr(player, "stop"):
+            player.stop()
+        self.ctx.sequencer.interrupt([], now=self.world.now())
+
+    def to_rest(self, timeout_s: float = 5.0) -> bool:
+        """Bring the arms back to neutral now (skipping the hold) and wait until they are there."""
+        sequencer = self.ctx.sequencer
+        if sequencer.state == State.HOLDING and sequencer.settled():
+            sequencer.interrupt([], now=self.world.now())
+        return self.world.run_until(lambda: sequencer.state == State.IDLE and sequencer.settled(), timeout_s)

@@ -1,0 +1,65 @@
+"""Time for the tour: one control period at a time, on a virtual or a real clock.
+
+With a FakeClock (simulation) the tour owns the 50 Hz loop and ticks it itself, so physics, the
+sequencer, the base controller and scripted questions all advance in lockstep and a run is as fast
+as the CPU allows. With a real clock (the G1) the loop runs on its own thread and advance() just
+waits one period. Either way the base integrates its odometry after each period, and the base's
+pose goes to the MCAP recording a few times a second.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from emopose.tour.navigator import MobileBase
+
+
+class TourWorld:
+    def __init__(self, ctx, base: MobileBase, record_hz: float = 10.0) -> None:
+        self.ctx, self.base = ctx, base
+        self.loop = ctx.open()
+        self.dt = self.loop.dt
+        self._record_every = max(1, round(1.0 / (record_hz * self.dt)))
+        self._ticks = 0
+
+    def now(self) -> float:
+        return self.ctx.clock.now()
+
+    @property
+    def stream_time(self) -> float:
+        return self.loop.stream_time
+
+    def advance(self) -> None:
+        if self.loop.running:
+            self.ctx.clock.sleep_until(self.ctx.clock.now() + self.dt)
+            if self.loop.error is not None:
+                raise RuntimeError("control loop failed") from self.loop.error
+        else:
+            self.loop.tick()
+        self.base.after_tick(self.dt)
+        self._ticks += 1
+        if self._ticks % self._record_every == 0:
+            self.record_base()
+
+    def run_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
+        end = self.now() + timeout_s
+        while not done():
+            if self.now() >= end:
+                return False
+            self.advance()
+        return True
+
+    def run_for(self, seconds: float) -> None:
+        end = self.now() + seconds
+        while self.now() < end:
+            self.advance()
+
+    def record(self, topic: str, payload: dict) -> None:
+        if self.ctx.recorder is not None:
+            self.ctx.recorder.write(topic, self.stream_time, payload)
+
+    def record_base(self) -> None:
+        self.record("/base/odometry", self.base.odometry().as_dict())
+        true_pose = getattr(self.base, "true_pose", None)
+        if true_pose is not None:
+            self.record("/base/true", true_pose().as_dict())

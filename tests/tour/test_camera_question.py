@@ -1,0 +1,57 @@
+"""Camera-grounded answers: "what is this?" sends the head camera frame to the VLM as an image part.
+
+The llm planner talks to a local fake OpenAI server (tests/planners/fake_openai.py) that records
+every request; the tour runs in MuJoCo, so the image is a real offscreen render of the head camera.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "planners"))
+from fake_openai import FakeOpenAI
+
+from emopose.app import run
+from tests.tour.tour_helpers import RENDER_SKIP, small, tour_config
+
+
+def user_content(body: dict):
+    return body["messages"][-1]["content"]
+
+
+@pytest.mark.skipif(RENDER_SKIP is not None, reason=str(RENDER_SKIP))
+def test_scene_question_attaches_the_head_camera_frame_to_the_vlm_request(tmp_path):
+    scenario = small(route=["first"], interruptions=[
+        {"at_stop": "first", "after_s": 1.5, "text": "What is this?"}])
+    path = tmp_path / "tour.yaml"
+    path.write_text(yaml.safe_dump(scenario))
+    with FakeOpenAI() as server:
+        cfg = tour_config(tmp_path, "planner=llm", f"planner.api_base={server.url}", "planner.model=openai/fake-model",
+                          "planner.cache=false", "planner.max_retries=0", f"job.tour_file={path}")
+        results = run(cfg, tmp_path / "run")
+        requests = list(server.requests)
+    with_image = [r for r in requests if isinstance(user_content(r), list)]
+    assert len(with_image) == 1, "only the scene question carries a picture"
+    text, image = user_content(with_image[0])
+    assert text == {"type": "text", "text": "What is this?"}  # the visitor's own words: respond mode
+    assert image["type"] == "image_url"
+    url = image["image_url"]["url"]
+    assert url.startswith("data:image/png;base64,")
+    import imageio.v3 as iio
+
+    frame = iio.imread(io.BytesIO(base64.b64decode(url.split(",", 1)[1])))
+    assert frame.shape == (240, 320, 3) and frame.std() > 5  # a real render, not a blank
+    # The dialogue so far (the interrupted narration) travels with the question.
+    history = with_image[0]["messages"][1:-1]
+    assert history and history[-1]["role"] == "assistant"
+    narration_requests = [r for r in requests if r is not with_image[0]]
+    assert narration_requests and all(isinstance(user_content(r), str) for r in narration_requests)
+    exchange = results["exchanges"][0]
+    assert exchange["image_attached"] and exchange["question"] == "What is this?"
+    assert results["stops_within_tolerance"] == 1 and results["ended_at_rest"]
