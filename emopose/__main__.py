@@ -12,6 +12,7 @@ from emopose import app
 from emopose.build import ConfigError
 from emopose.config import register_resolvers
 from emopose.library import LibraryError
+from emopose.robot.model import ModelError
 
 register_resolvers()
 
@@ -20,7 +21,7 @@ register_resolvers()
 def main(cfg: DictConfig) -> None:
     try:
         app.run(cfg, HydraConfig.get().runtime.output_dir)
-    except (ConfigError, LibraryError) as exc:
+    except (ConfigError, LibraryError, ModelError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         sys.exit(2)
 

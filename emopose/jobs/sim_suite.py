@@ -1,0 +1,154 @@
+"""+experiment=sim_suite: the paper's MuJoCo protocol (Simulation and Physical-G1 Evaluation).
+
+Class-balanced trials, each the class default at one intensity (level 3), run through the real
+pipeline (parse -> resolve -> modulate -> schedule -> sequence -> dispatch until=settle) on the
+configured backend with the control loop's virtual clock; physics advances in send(), so trial time
+and simulated time agree. A session does not reset the robot between utterances: each trial starts
+where the previous one left the arms (its held end pose), or, on alternate trials, after the
+sequencer's own 2 s hold + 1 s recovery to neutral. Completion = a "completed" event for the trial's
+command without a stop request, a safety rejection or a dispatch timeout. Tracking per
+emopose/jobs/tracking.py (tick alignment, N resampled points, Eq. sim-MAE).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from emopose import CLASSES
+from emopose.context import RunContext
+from emopose.jobs.report import write_results
+from emopose.jobs.sim_report import suite_markdown
+from emopose.jobs.tracking import StreamTap, latency_ms, sim_mae, tracking_error
+from emopose.planners.base import PlannerOutput
+from emopose.sequencer import State
+
+log = logging.getLogger(__name__)
+START_MODES = ("alternate", "previous", "rest")
+
+
+@dataclass
+class SimSuiteJob:
+    trials: int = 160
+    intensity: int = 3
+    start_from: str = "alternate"  # alternate | previous (held end pose) | rest (after neutral recovery)
+    points: int = 100
+    seed: int = 0
+    rest_timeout_s: float = 10.0
+
+    def __post_init__(self) -> None:
+        if self.trials < len(CLASSES) or self.trials % len(CLASSES):
+            raise ValueError(f"sim_suite: trials must be a positive multiple of {len(CLASSES)} "
+                             f"(class-balanced), got {self.trials}")
+        if self.start_from not in START_MODES:
+            raise ValueError(f"sim_suite: start_from must be one of {START_MODES}, got {self.start_from!r}")
+        if not 1 <= self.intensity <= 5:
+            raise ValueError(f"sim_suite: intensity must be 1..5, got {self.intensity}")
+
+    def __call__(self, ctx: RunContext) -> dict:
+        motions = {c: ctx.library.class_default(c) for c in CLASSES}
+        missing = [c for c, m in motions.items() if m is None]
+        if missing:
+            raise ValueError(f"sim_suite: library has no motion for classes {missing}")
+        order = np.random.default_rng(self.seed).permutation(
+            np.repeat(np.array(CLASSES), self.trials // len(CLASSES)))
+        loop = ctx.open()
+        tap = StreamTap(loop.backend)
+        loop.backend = tap  # capture command/state pairs in memory, tick by tick
+        t0 = ctx.clock.now() - loop.stream_time
+        rows = [self._trial(ctx, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
+        results = self._summarise(ctx, rows)
+        write_results(ctx.run_dir, results, suite_markdown(results))
+        (ctx.run_dir / "trials.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+        print(suite_markdown(results).split("\n\n")[1])
+        return results
+
+    def _start_mode(self, k: int) -> str:
+        if self.start_from == "alternate":
+            return "rest" if k % 2 else "previous"
+        return self.start_from
+
+    def _trial(self, ctx: RunContext, tap: StreamTap, t0: float, k: int, cls: str, motion: str) -> dict:
+        loop, sequencer = ctx.loop, ctx.sequencer
+        start = self._start_mode(k)
+        if start == "rest":
+            loop.run_until(lambda: sequencer.state == State.IDLE, self.rest_timeout_s)
+        q_start = sequencer.last.copy()
+        first_tick, first_build = len(tap), len(sequencer.construction_s)
+        backend = tap.backend
+        if hasattr(backend, "max_actuator_force_ratio"):
+            backend.max_actuator_force_ratio = 0.0  # per-trial peak
+        turn = ctx.new_turn(f"sim trial {k}: {cls}", use_history=False)
+        turn.planner_output = PlannerOutput(raw=json.dumps({"reply": f"Trial {k}.", "gestures": [
+            {"class": cls, "variant": motion, "intensity": self.intensity}]}))
+        ctx.pipeline.run(turn, ctx)
+        ctx.record_turn(turn)
+        report, command = turn.dispatched, turn.submitted.commands[0]
+        mine = [e for e in report.events if e.command_id == command.id]
+        kinds = {e.kind for e in mine}
+        row = {"trial": k, "class": cls, "motion": turn.resolved[0].entry.name, "start": start,
+               "start_offset_rad": float(np.max(np.abs(q_start - command.keyframes[0]))),
+               "completed": "completed" in kinds and not kinds & {"stopped", "rejected"} and report.completed,
+               "stopped": "stopped" in kinds, "rejected": "rejected" in kinds, "timeout": not report.completed,
+               "construction_s": sequencer.construction_s[first_build:],
+               "submission_s": list(turn.submitted.submission_s)}
+        row["force_ratio"] = float(getattr(backend, "max_actuator_force_ratio", float("nan")))
+        started = next((e for e in mine if e.kind == "started"), None)
+        done = next((e for e in mine if e.kind == "completed"), None)
+        if started is None or done is None:
+            log.warning("trial %d (%s) did not complete: %s", k, cls, sorted(kinds))
+            return row
+        a, b = tap.tick_at(started.t - t0, first_tick), tap.tick_at(done.t - t0, first_tick)
+        commands, states = tap.window(a, b)
+        error = tracking_error(commands, states, self.points)
+        row.update(ticks=b - a + 1, duration_s=(b - a) * loop.dt, mae_rad=error.mae,
+                   mae_time_aligned_rad=error.mae_time_aligned, max_abs_error_rad=error.max_abs,
+                   contacts=sorted({f"{p[0]}|{p[1]}" for tick, _, p in tap.contacts if a <= tick <= b}))
+        row["_error"] = error
+        return row
+
+    def _summarise(self, ctx: RunContext, rows: list[dict]) -> dict:
+        errors = [r.pop("_error") for r in rows if "_error" in r]
+        done = [r for r in rows if "mae_rad" in r]
+        per_class, per_class_time, per_class_force = {}, {}, {}
+        for cls in CLASSES:
+            mine = [e for r, e in zip(done, errors) if r["class"] == cls]
+            per_class[cls] = sim_mae(mine)
+            per_class_time[cls] = sim_mae(mine, "time")
+            per_class_force[cls] = max((r["force_ratio"] for r in rows if r["class"] == cls), default=0.0)
+        contacts = [{"trial": r["trial"], "class": r["class"], "pair": p} for r in done for p in r["contacts"]]
+        mae = sim_mae(errors)
+        return {
+            "trials": len(rows),
+            "completed": sum(r["completed"] for r in rows),
+            "stops": sum(r["stopped"] for r in rows),
+            "timeouts": sum(r["timeout"] for r in rows),
+            "rejected": sum(r["rejected"] for r in rows),
+            "mae_rad": mae,
+            "mae_deg": float(np.degrees(mae)),
+            "per_class_mae_rad": per_class,
+            "mae_time_aligned_rad": sim_mae(errors, "time"),
+            "per_class_mae_time_aligned_rad": per_class_time,
+            "max_abs_error_rad": max((r["max_abs_error_rad"] for r in done), default=float("nan")),
+            "max_actuator_force_ratio": max(per_class_force.values()),
+            "per_class_max_actuator_force_ratio": per_class_force,
+            "self_contacts": len(contacts),
+            "self_contact_pairs": contacts[:50],
+            "construction_ms": latency_ms([s for r in rows for s in r["construction_s"]]),
+            "submission_ms": latency_ms([s for r in rows for s in r["submission_s"]]),
+            "start_offset_rad": {m: float(np.mean([r["start_offset_rad"] for r in rows if r["start"] == m] or [0]))
+                                 for m in ("previous", "rest")},
+            "motions": {c: ctx.library.class_default(c).name for c in CLASSES},
+            "intensity": self.intensity,
+            "start_from": self.start_from,
+            "points": self.points,
+            "backend": ctx.backend.name,
+            "dispatch_until": getattr(next((s for s in ctx.pipeline.stages if s.name == "dispatch"), None),
+                                      "until", None),
+            "alignment": "tick: command n vs simulated pose after tick n's physics (stamped t_n + 0.02 s); "
+                         "time: that pose vs command n+1 issued at t_n + 0.02 s",
+            "mcap": str(ctx.recorder.path) if ctx.recorder else None,
+        }
