@@ -11,8 +11,8 @@ from emopose.build import ConfigError, build_context, make
 from emopose.config import CONFIG_DIR
 
 HEAVY_PLANNERS = {"local", "sbert_centroids"}  # load MiniLM: covered by the slow planner tests
-# reset and tour are not in the primary defaults (experiments add them); tour files: tests/tour/test_scenario.py
-GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name not in ("experiment", "reset", "tour"))
+# tour is not in the primary defaults (tour experiments add it); tour files: tests/tour/test_scenario.py
+GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name not in ("experiment", "tour"))
 
 
 def options(group: str) -> list[str]:

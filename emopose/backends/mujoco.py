@@ -5,8 +5,8 @@ advances CONTROL_DT in `substeps` steps. Gravity is compensated through the actu
 body gravcomp + joint actuatorgravcomp), so the compensating torque shares each joint's torque
 limit, as a real motor's would. With velocity_feedforward the servo tracks (q, dq), dq being the
 stream's finite difference, as LowCmd_ hands q and dq to the G1's motor PD; without it a 0.3 rad,
-0.5 Hz sine lags to ~0.014 rad MAE instead of ~0.005. Streams written to the Recorder:
-  /joints/command  {"t", "q"}  the target, stamped with the tick time t
+0.5 Hz sine lags to ~0.014 rad MAE instead of ~0.005. Streams written to the Recorder (the control
+loop records the commanded stream, /joints/command, itself):
   /joints/sim      {"t", "q"}  the simulated pose at the end of that period, stamped t + CONTROL_DT
   /joints/torque   {"t", "tau", "ratio"}  joint torque (servo + gravcomp) and max |tau|/limit
 """
@@ -152,7 +152,6 @@ class MujocoBackend:
         self._tick += 1
         if self._recorder is not None:
             t_sim = t + CONTROL_DT
-            self._recorder.write("/joints/command", t, {"t": t, "q": target.tolist()})
             self._recorder.write("/joints/sim", t_sim, {"t": t_sim, "q": q_sim.tolist()})
             self._recorder.write(
                 "/joints/torque", t_sim, {"t": t_sim, "tau": tau.tolist(), "ratio": ratio}
