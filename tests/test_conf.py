@@ -46,8 +46,11 @@ def test_every_group_option_composes_and_instantiates(group, option, library):
 
 
 @pytest.mark.parametrize("experiment", options("experiment"))
-def test_every_experiment_composes_and_builds_its_job(experiment):
-    cfg = compose_with(f"+experiment={experiment}")
+def test_every_experiment_composes_and_builds_its_job(experiment, tmp_path):
+    recording = tmp_path / "session.mcap"
+    recording.touch()
+    required = {"replay": [f"mcap={recording}"]}  # experiments with a mandatory argument
+    cfg = compose_with(f"+experiment={experiment}", *required.get(experiment, []))
     job = instantiate(cfg.job, _convert_="all")
     assert callable(job)
 

@@ -53,7 +53,7 @@ def test_sync_eval_falls_back_to_the_fixture_and_needs_true_word_events(tmp_path
 @pytest.mark.parametrize("group, option", [("asr", "none"), ("asr", "litellm"), ("player", "auto"),
                                            ("player", "none"), ("tts", "espeak"), ("tts", "litellm")])
 def test_speech_config_options_build(group, option, tmp_path):
-    overrides = [f"{group}={option}" if group == "tts" else f"+{group}={option}"]
+    overrides = [f"{group}={option}"]
     if group == "tts":
         overrides.append(f"tts.audio_dir={tmp_path}")
     node = _compose(overrides)[group]
@@ -61,6 +61,6 @@ def test_speech_config_options_build(group, option, tmp_path):
 
 
 def test_thinking_options_build(tmp_path, library):
-    assert make(_compose(["+thinking=none"]).get("thinking"), "thinking") is None
-    node = _compose(["+thinking=chin_stroke", "thinking.motion=doubting_a"]).thinking
+    assert make(_compose(["thinking=none"]).get("thinking"), "thinking") is None
+    node = _compose(["thinking=chin_stroke", "thinking.motion=doubting_a"]).thinking
     assert make(node, "thinking", library=library).motion == "doubting_a"

@@ -37,7 +37,8 @@ def library_overrides(folder: Path) -> list[str]:
 @functools.lru_cache(maxsize=8)
 def _composed(overrides: tuple[str, ...]):
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        return compose("config", overrides=["+experiment=serve", "run.record=false", *overrides])
+        return compose("config", overrides=["+experiment=serve", "planner=keyword", "run.record=false",
+                                             *overrides])
 
 
 def compose_serve(folder: Path, *overrides: str):
