@@ -65,7 +65,7 @@ def main() -> None:
              for e in library.snapshot.entries.values() if e.motion_type == "sequence" for level in range(1, 6)]
     build_s, check_s, per_motion = [], [], {}
     gc.disable()  # a collection pause is not construction time; reported separately below if it mattered
-    for entry, level, keyframes in cases:
+    for entry, _level, keyframes in cases:
         builder.build(keyframes, entry.default_duration, neutral)  # warm-up
         for _ in range(args.repeats):
             dt, trajectory = timed(builder.build, keyframes, entry.default_duration, neutral)

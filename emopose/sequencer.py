@@ -19,14 +19,14 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from enum import Enum
+from enum import StrEnum
 
 import numpy as np
 
 from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 
-class State(str, Enum):
+class State(StrEnum):
     IDLE = "idle"
     EXECUTING = "executing"
     HOLDING = "holding"

@@ -44,7 +44,7 @@ def make_library_dir(folder: Path) -> Path:
     (folder / "limits.yaml").write_text(yaml.safe_dump(
         {"joints": NAMES, "lower": LOWER, "upper": UPPER, "max_velocity": 8.0}))
     write_motion(folder, "neutral_rest", "neutral", [REST], motion_type="pose")
-    for k, cls in enumerate(CLASSES):
+    for cls in CLASSES:
         if cls == "neutral":
             write_motion(folder, "idle_breathe", "neutral", [REST, raised(0.1, 3), REST])
             continue

@@ -5,9 +5,9 @@ import threading
 import numpy as np
 import pytest
 
+from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
 from emopose.control_loop import ControlLoop
-from emopose.backends.dry_run import DryRunBackend
 from emopose.sequencer import GestureCommand, Sequencer, State
 from emopose.trajectory import TrajectoryBuilder
 

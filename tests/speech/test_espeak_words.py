@@ -25,7 +25,7 @@ REPLIES = [
 
 def _long_reply() -> str:
     rng = random.Random(7)
-    words = "the robot arm is over there and we can see 42 interesting things in this lab today".split()
+    words = ["the", "robot", "arm", "is", "over", "there", "and", "we", "can", "see", "42", "interesting", "things", "in", "this", "lab", "today"]
     return " ".join(rng.choice(words) for _ in range(500)) + " FINALWORD."
 
 
@@ -35,7 +35,7 @@ def test_word_timings_monotone_inside_audio_and_on_the_text(espeak, reply):
     assert clip.duration_s > 0 and not clip.estimated and clip.words
     starts = [w.start_s for w in clip.words]
     assert starts == sorted(starts)
-    assert 0.0 <= starts[0] and starts[-1] <= clip.duration_s
+    assert starts[0] >= 0.0 and starts[-1] <= clip.duration_s
     previous_end = 0
     for word in clip.words:
         assert reply[word.char_start:word.char_end] == word.text  # offsets index the reply itself
