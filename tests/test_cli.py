@@ -20,7 +20,7 @@ def run_cli(tmp_path, *args: str, timeout: float = 900) -> subprocess.CompletedP
 
 @pytest.mark.slow
 def test_plan_experiment_prints_plan_resolution_releases_and_mcap(tmp_path):
-    done = run_cli(tmp_path, "+experiment=plan", "planner=keyword", "utterance=Welcome! Look over there.")
+    done = run_cli(tmp_path, "+experiment=plan", "planner=keyword", "utterance='Welcome! Look over there.'")
     assert done.returncode == 0, done.stderr[-2000:]
     assert "face_wave" in done.stdout and "point_forward_right" in done.stdout
     assert "session.mcap" in done.stdout

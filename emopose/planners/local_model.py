@@ -101,21 +101,31 @@ class FineTunedClassifier:
         return list(self.body.encoder.layer[-self.config.trainable_layers:]) + [self.head]
 
     def _embed(self, texts: list[str]):
+        """(class embedding from the fine-tuned top, semantic embedding from the last frozen layer).
+
+        Both are normalised mean-pooled token states. The fine-tuned top separates the eight classes
+        and blurs differences inside one; the frozen layer keeps the general sentence similarity that
+        matching a text to motion descriptions needs."""
         import torch
 
         batch = self.tokenizer(texts, padding=True, truncation=True, max_length=64, return_tensors="pt")
-        hidden = self.body(**batch).last_hidden_state
-        mask = batch["attention_mask"].unsqueeze(-1).to(hidden.dtype)
-        return torch.nn.functional.normalize((hidden * mask).sum(1) / mask.sum(1), dim=-1)
+        out = self.body(**batch, output_hidden_states=True)
+        mask = batch["attention_mask"].unsqueeze(-1).to(out.last_hidden_state.dtype)
+
+        def pooled(hidden):
+            return torch.nn.functional.normalize((hidden * mask).sum(1) / mask.sum(1), dim=-1)
+
+        frozen = out.hidden_states[-1 - self.config.trainable_layers]
+        return pooled(out.last_hidden_state), pooled(frozen)
 
     def encode_and_classify(self, texts: list[str]) -> tuple[np.ndarray, np.ndarray]:
-        """(embeddings (N, 384), probabilities (N, 8)) for texts, in one forward pass."""
+        """(semantic embeddings (N, 384), class probabilities (N, 8)) for texts, in one forward pass."""
         import torch
 
         with self._lock, torch.inference_mode():
-            vectors = self._embed(texts)
-            proba = torch.softmax(self.head(vectors) * self.config.logit_scale, dim=-1)
-        return vectors.numpy(), proba.numpy()
+            class_vectors, semantic = self._embed(texts)
+            proba = torch.softmax(self.head(class_vectors) * self.config.logit_scale, dim=-1)
+        return semantic.numpy(), proba.numpy()
 
     def fit(self, items: list[LabelledText]) -> None:
         import torch
@@ -140,7 +150,7 @@ class FineTunedClassifier:
             rng.shuffle(batches)
             total = 0.0
             for batch in batches:
-                logits = self.head(self._embed([items[i].text for i in batch])) * cfg.logit_scale
+                logits = self.head(self._embed([items[i].text for i in batch])[0]) * cfg.logit_scale
                 loss = torch.nn.functional.cross_entropy(logits, labels[batch])
                 optimizer.zero_grad()
                 loss.backward()
