@@ -5,6 +5,10 @@ EXECUTING --done, successor released--> BLENDING (cubic, <= blend_s) --> EXECUTI
 EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> BLENDING to neutral
                                                 (recover_s) --> IDLE
 any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
+Beyond the paper (off by default): with `preempt_after_s` set, a queued command whose release time has
+passed by that much cuts the running motion short with a normal blend, so long motions do not push
+later gestures away from their words; a negative value (-blend_s) starts that blend early so the
+successor begins on its word.
 
 `step(now)` is called once per 50 Hz tick and returns the 14-DoF target to publish; every transition
 starts from the latest published pose, so the stream never jumps. submit/interrupt are thread-safe.
@@ -68,6 +72,7 @@ class Sequencer:
         recover_s: float = 1.0,
         interrupt_blend_s: float = 0.3,
         neutral_tolerance: float = 0.02,
+        preempt_after_s: float | None = None,
         on_event: Callable[[Event], None] | None = None,
     ) -> None:
         self.builder = builder
@@ -76,6 +81,7 @@ class Sequencer:
         self.blend_s, self.hold_s, self.recover_s = blend_s, hold_s, recover_s
         self.interrupt_blend_s = interrupt_blend_s
         self.neutral_tolerance = neutral_tolerance
+        self.preempt_after_s = preempt_after_s
         self.on_event = on_event
         self.events: list[Event] = []
         self.construction_s: list[float] = []
@@ -132,6 +138,10 @@ class Sequencer:
         with self._lock:
             if self.state in (State.EXECUTING, State.BLENDING):
                 self._advance(now)
+            if self.state == State.EXECUTING and self._overdue(now):
+                self._emit(now, "stopped", self._active, "preempted by an overdue successor")
+                head = self._queue.popleft()
+                self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
             if self.state in (State.IDLE, State.HOLDING) or self._recovering():
                 self._maybe_start(now)
             if self.state == State.HOLDING and now - self._hold_since >= self.hold_s:
@@ -159,6 +169,10 @@ class Sequencer:
                 self._set_state(now, State.HOLDING)
         else:
             self._set_state(now, State.IDLE)
+
+    def _overdue(self, now: float) -> bool:
+        return (self.preempt_after_s is not None and bool(self._queue)
+                and now - self._queue[0].release_at >= self.preempt_after_s)
 
     def _recovering(self) -> bool:
         return self.state == State.BLENDING and self._after_blend is None and self._active is None

@@ -162,3 +162,20 @@ def test_submit_and_interrupt_are_thread_safe(library, rig):
     loop.stop()
     assert loop.error is None and loop.stats.ticks > 10
     assert_continuous(stream, library)
+
+
+def test_overdue_successor_preempts_only_when_enabled(library, rest):
+    for preempt, expect_stop in ((None, False), (0.1, True)):
+        clock = FakeClock()
+        sequencer = Sequencer(TrajectoryBuilder(library.limits), rest, preempt_after_s=preempt)
+        loop = ControlLoop(sequencer, DryRunBackend(), clock)
+        loop.begin(rest)
+        sequencer.submit(command(library, "pointing_a"))  # 1 s long
+        sequencer.submit(command(library, "welcoming_b", release_at=0.3))
+        loop.run_until(sequencer.settled, 10)
+        started = {e.name: e.t for e in kinds(sequencer, "started")}
+        assert bool(kinds(sequencer, "stopped")) == expect_stop
+        if expect_stop:
+            assert started["welcoming_b"] <= 0.3 + 0.1 + 0.3 + 0.02  # overdue by 0.1 s, then a <= 0.3 s blend
+        else:
+            assert started["welcoming_b"] >= 1.0
