@@ -18,6 +18,7 @@ import asyncio
 import json
 import logging
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Coroutine, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -46,7 +47,7 @@ def run_coroutine(coro: Coroutine) -> Any:
         return pool.submit(asyncio.run, coro).result()
 
 
-class ChatPlanner:
+class ChatPlanner(ABC):
     """Base class; `**llm` are LLMClient's settings (model, api_base, temperature, cache, ...)."""
 
     name = "chat"
@@ -63,8 +64,9 @@ class ChatPlanner:
         self.client = LLMClient(**llm)
 
     # -- what subclasses define ------------------------------------------------------------------
+    @abstractmethod
     def system_prompt(self) -> str:
-        raise NotImplementedError
+        """The rendered system message for the current library."""
 
     def to_contract(self, text: str, request: PlanRequest) -> str:
         return text

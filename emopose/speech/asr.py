@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import time
+from abc import ABC, abstractmethod
 from pathlib import Path
 
 log = logging.getLogger(__name__)
@@ -20,7 +21,7 @@ class ASRError(RuntimeError):
     """An utterance could not be obtained; the message names the config key or file to fix."""
 
 
-class Recognizer:
+class Recognizer(ABC):
     name = "base"
 
     def utterance(self, text: str | None = None, audio: str | Path | None = None) -> str:
@@ -31,8 +32,9 @@ class Recognizer:
             raise ASRError("no utterance: give typed text or an audio file")
         return self.transcribe(audio)
 
+    @abstractmethod
     def transcribe(self, audio: str | Path) -> str:
-        raise NotImplementedError
+        """The transcript of an audio file."""
 
 
 class TypedText(Recognizer):
