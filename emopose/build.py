@@ -52,9 +52,21 @@ def safety_check(checker: Any):
     return check
 
 
+def check_planner(planner: Any) -> None:
+    """Planners that call a service say what is missing (key, model string) before any run starts."""
+    check = getattr(planner, "check", None)
+    if check is None:
+        return
+    try:
+        check()
+    except ValueError as exc:
+        raise ConfigError(f"planner: {exc}") from exc
+
+
 def build_context(cfg: DictConfig, run_dir: str | Path) -> RunContext:
     library: MotionLibrary = make(cfg.library, "library")
     planner = make(cfg.planner, "planner", library=library)
+    check_planner(planner)
     stages = {name: make(node, f"pipeline.stages.{name}") for name, node in cfg.pipeline.stages.items()}
     backend = make(cfg.backend, "backend")
     realtime = cfg.run.clock == "monotonic" or (cfg.run.clock == "auto" and getattr(backend, "realtime", False))

@@ -70,3 +70,10 @@ def test_wrong_stage_value_names_the_key(tmp_path):
     cfg = compose_with("pipeline.stages.schedule.mode=sideways", "planner=keyword")
     with pytest.raises(ConfigError, match="pipeline.stages.schedule"):
         build_context(cfg, tmp_path)
+
+
+def test_hosted_llm_without_a_key_is_refused_before_the_run(tmp_path, monkeypatch):
+    monkeypatch.delenv("OPENAI_API_KEY", raising=False)
+    cfg = compose_with("planner=llm", "planner.model=openai/gpt-4o-mini")
+    with pytest.raises(ConfigError, match="OPENAI_API_KEY"):
+        build_context(cfg, tmp_path)
