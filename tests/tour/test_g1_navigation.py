@@ -46,25 +46,10 @@ class FakeRobotOdometry:
         return Pose2D(x, y, yaw)
 
 
-def connected(loco, attempts: int = 5) -> None:
-    """Our endpoints can match before the fake's reader has matched ours, and a request written in that
-    window is lost; on a busy machine the first call may need a retry."""
-    from emopose.backends.g1 import LocoTimeoutError
-
-    for attempt in range(attempts):
-        try:
-            loco.get_fsm_id()
-            return
-        except LocoTimeoutError:
-            if attempt == attempts - 1:
-                raise
-
-
 def test_g1_base_walks_to_a_pose_on_onboard_odometry(robot):
     from emopose.backends.g1 import LocoClient
 
     with LocoClient(domain_id=robot.domain_id, timeout_s=2.0) as loco:
-        connected(loco)
         start = Pose2D(1.0, 2.0, math.pi / 2)  # where the tour says the robot stands
         base = G1Base(loco, FakeRobotOdometry(loco, robot), origin=start)
         navigator = Navigator(base, NavigationSettings(stop_tolerance_m=0.10), lambda: time.sleep(0.02),

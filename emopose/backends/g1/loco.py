@@ -30,6 +30,9 @@ from emopose.backends.g1.errors import LocoError, LocoTimeoutError
 log = logging.getLogger(__name__)
 
 
+RESEND_S = 0.25  # re-send an unanswered request this often until the call's timeout
+
+
 def _clamp(name: str, value: float, limit: float) -> float:
     if not math.isfinite(value):
         raise ValueError(f"loco: {name} must be finite, got {value}")
@@ -130,21 +133,25 @@ class LocoClient:
                     )
             request_id = next(self._ids)
             header = RequestHeader_(identity=RequestIdentity_(id=request_id, api_id=api_id))
-            self._requests.write_typed(
-                Request_(header=header, parameter=json.dumps(parameter), binary=[])
-            )
+            request = Request_(header=header, parameter=json.dumps(parameter), binary=[])
+            # Our writer can match the server's reader before the server's side has matched ours, and
+            # a request written in that window is lost; so the same request (same id, and every loco
+            # api is idempotent) is re-sent until an answer comes or the deadline passes.
             while (remaining := deadline - time.monotonic()) > 0:
-                for response in self._responses.take_typed(timeout_s=remaining):
-                    if response.header.identity.id != request_id:
-                        continue  # another client's answer
-                    code = int(response.header.status.code)
-                    if code != 0:
-                        raise LocoError(
-                            api_id,
-                            code,
-                            f"loco api {api_id} failed with status code {code} ({where})",
-                        )
-                    return response.data
+                self._requests.write_typed(request)
+                wait_until = time.monotonic() + min(RESEND_S, remaining)
+                while (window := wait_until - time.monotonic()) > 0:
+                    for response in self._responses.take_typed(timeout_s=window):
+                        if response.header.identity.id != request_id:
+                            continue  # another client's answer, or a duplicate of an older one
+                        code = int(response.header.status.code)
+                        if code != 0:
+                            raise LocoError(
+                                api_id,
+                                code,
+                                f"loco api {api_id} failed with status code {code} ({where})",
+                            )
+                        return response.data
             raise LocoTimeoutError(
                 f"loco api {api_id}: no response from {where} within {self.timeout_s:g} s"
             )
