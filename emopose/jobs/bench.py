@@ -17,7 +17,7 @@ from emopose.bench.suites import TIERS, load_bench
 from emopose.bench.tables import comparison_markdown, fmt
 from emopose.context import RunContext
 from emopose.jobs.report import write_results
-from emopose.jobs.suite_planning import latency_summary, plan_suite, resolve_passes
+from emopose.jobs.suite_planning import plan_suite, resolve_passes, run_summary
 from emopose.planners.base import PlanRequest
 
 
@@ -60,10 +60,7 @@ class BenchJob:
             "accuracy": tier_accuracy(predictions, TIERS),
             "per_pass": [{t: accuracy((q["label"], q["pred"]) for q in preds if q["tier"] == t)
                           for t in self.tiers} for preds in by_pass(predictions).values()],
-            "fallbacks": sum(i.fallback for i in planned_all),
-            "failures": sum(i.plan is None for i in planned_all),
-            "latency_s": latency_summary(planned_all),
-            "wall_s": time.perf_counter() - started,
+            **run_summary(planned_all, started),
             "predictions": predictions,
         }
         markdown = comparison_markdown([results]) + "\n" + leading_confusions(predictions, self.tiers)

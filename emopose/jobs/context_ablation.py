@@ -15,7 +15,7 @@ from emopose.bench.suites import load_context
 from emopose.bench.tables import comparison_markdown
 from emopose.context import RunContext
 from emopose.jobs.report import write_results
-from emopose.jobs.suite_planning import latency_summary, plan_suite, resolve_passes
+from emopose.jobs.suite_planning import plan_suite, resolve_passes, run_summary
 from emopose.planners.base import PlanRequest
 
 
@@ -54,10 +54,7 @@ class ContextAblationJob:
             "accuracy": {k: paired[k] for k in ("with_history", "without_history", "gain")},
             "per_pass": paired["per_pass"],
             "discordant": paired["discordant"],
-            "fallbacks": sum(i.fallback for i in planned_all),
-            "failures": sum(i.plan is None for i in planned_all),
-            "latency_s": latency_summary(planned_all),
-            "wall_s": time.perf_counter() - started,
+            **run_summary(planned_all, started),
             "predictions": predictions,
         }
         d = paired["discordant"]

@@ -17,7 +17,7 @@ from emopose.bench.suites import load_sequence
 from emopose.bench.tables import comparison_markdown
 from emopose.context import RunContext
 from emopose.jobs.report import write_results
-from emopose.jobs.suite_planning import PlannedItem, latency_summary, plan_suite, resolve_passes
+from emopose.jobs.suite_planning import PlannedItem, plan_suite, resolve_passes, run_summary
 from emopose.planners.base import PlanRequest
 
 COUNT_KEYS = ("over", "under", "failed")
@@ -70,10 +70,7 @@ class SequenceSuiteJob:
             "segmentation": {f"{k}_total": sum(s[k] for s in per_pass) for k in COUNT_KEYS}
             | {f"{k}_per_pass": [s[k] for s in per_pass] for k in COUNT_KEYS},
             "per_pass": per_pass,
-            "fallbacks": sum(i.fallback for i in planned_all),
-            "failures": sum(i.plan is None for i in planned_all),
-            "latency_s": latency_summary(planned_all),
-            "wall_s": time.perf_counter() - started,
+            **run_summary(planned_all, started),
             "predictions": predictions,
         }
         seg = results["segmentation"]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import logging
 import sys
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -96,3 +97,9 @@ def latency_summary(items: Sequence[PlannedItem]) -> dict:
     if values.size == 0:
         return {"mean": None, "p95": None}
     return {"mean": float(values.mean()), "p95": float(np.percentile(values, 95))}
+
+
+def run_summary(planned: Sequence[PlannedItem], started: float) -> dict:
+    """The fields every suite job reports about its planning run (fallbacks, failures, latency, wall time)."""
+    return {"fallbacks": sum(i.fallback for i in planned), "failures": sum(i.plan is None for i in planned),
+            "latency_s": latency_summary(planned), "wall_s": time.perf_counter() - started}
