@@ -1,6 +1,7 @@
 """Local planner latency per utterance after load (target p95 <= 20 ms), over the bench texts.
 
-    python benchmarks/local_planner.py [--items 480]
+    python benchmarks/local_planner.py [--items 480] [planner.OVERRIDE=VALUE ...]
+The planner is built from the composed Hydra config (conf/planner/local.yaml), as the app builds it.
 Prints JSON: load time, per-utterance latency mean/p50/p95/max in ms, records per plan.
 """
 
@@ -8,26 +9,30 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from hydra import compose, initialize_config_dir
 
-from emopose.config import PROJECT_ROOT
-from emopose.library import MotionLibrary
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
+
+from emopose.build import make
+from emopose.config import CONFIG_DIR, PROJECT_ROOT
 from emopose.planners.base import PlanRequest
-from emopose.planners.local import LocalPlanner
 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--items", type=int, default=480)
+    parser.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. planner.bf16_inference=false")
     args = parser.parse_args()
-    lib_dir = PROJECT_ROOT / "library/g1"
-    library = MotionLibrary.from_config(paths=[str(lib_dir)], limits=str(lib_dir / "limits.yaml"))
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=["planner=local", *args.overrides])
+    library = make(cfg.library, "library")
     started = time.perf_counter()
-    planner = LocalPlanner(library, [str(PROJECT_ROOT / "experiments/train/train.jsonl"),
-                                     str(PROJECT_ROOT / "experiments/train/train_sequences.jsonl")])
+    planner = make(cfg.planner, "planner", library=library)
     load_s = time.perf_counter() - started
     texts = [json.loads(line)["text"] for line in
              Path(PROJECT_ROOT / "experiments/bench/emopose_bench.jsonl").read_text().splitlines()][: args.items]

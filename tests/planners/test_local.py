@@ -3,19 +3,20 @@
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
+import numpy as np
 import pytest
 
 from emopose.config import PROJECT_ROOT
 from emopose.library import MotionLibrary
 from emopose.planners.base import PlanRequest
-from emopose.planners.local import anchoring_phrase, intensity_from_cues
+from emopose.planners.local import intensity_from_cues, trigger_span
+from emopose.planners.local_data import multi_act, single_act, synthetic_sequences
+from emopose.planners.local_model import Analysis
 from emopose.planners.segment import segments
 from emopose.stages.parse import parse_plan
-
-TRAIN_FILES = [str(PROJECT_ROOT / "experiments/train/train.jsonl"),
-               str(PROJECT_ROOT / "experiments/train/train_sequences.jsonl")]
 
 
 def test_intensity_cues():
@@ -25,9 +26,55 @@ def test_intensity_cues():
     assert intensity_from_cues("STOP RIGHT THERE") == 4
 
 
-def test_anchoring_phrase_prefers_class_cue_then_opening_words():
-    assert anchoring_phrase("Well, welcome to the lab", "welcoming") == "welcome"
-    assert anchoring_phrase("so the cabinet by the door holds it", "pointing") == "the cabinet by"
+def test_multi_act_items_assign_every_segment_to_an_annotated_act():
+    example = multi_act({"id": "x", "text": "Oh hello, come in! The coats go over there, on the left hooks.",
+                         "labels": ["welcoming", "pointing"], "anchors": ["come in", "over there"],
+                         "variants": ["beckon_in", "point_left"]})
+    assert [(example.text[a.start:a.end], a.label) for a in example.acts] == [
+        ("Oh hello, come in!", "welcoming"), ("The coats go over there, on the left hooks.", "pointing")]
+    assert example.boundaries == [0, 1, 0]
+    assert [example.text[a:b] for a, b in example.anchors] == ["come in", "over there"]
+    shared = {"id": "y", "text": "Yes over there.", "labels": ["agreeing", "pointing"],
+              "anchors": ["Yes", "over there"], "variants": ["double_hand_nod", "point_left"]}
+    assert multi_act(shared) is None  # two anchors in one segment: no usable act boundary
+
+
+def test_synthetic_sequences_join_items_of_different_classes():
+    singles = [single_act(f"s{k}", text, label) for k, (text, label) in enumerate([
+        ("Welcome aboard, everyone.", "welcoming"), ("The lifejackets are under your seat.", "pointing"),
+        ("Please don't lean over the rail!", "rejecting"), ("I'm not convinced the fog will lift.", "doubting")])]
+    joined = synthetic_sequences(singles, 40, seed=3)
+    assert len(joined) >= 30
+    for example in joined:
+        labels = [a.label for a in example.acts]
+        assert 2 <= len(labels) <= 4 and all(a != b for a, b in zip(labels, labels[1:]))
+        assert sum(example.boundaries) == len(labels) - 1
+        assert all(example.text[a.start:a.end].strip() for a in example.acts)
+    assert len({e.text for e in joined}) > 20
+
+
+def test_trigger_is_the_marked_run_of_whole_words_around_the_peak():
+    text = "Thanks for coming, the cloakroom is downstairs on the left."
+    act = (19, len(text) - 1)
+    words = [(m.start(), m.group()) for m in re.finditer(r"[\w']+", text)]
+    starts = [s for s, _ in words]
+    logits = np.full(len(starts), -3.0)
+    peak = [w for _, w in words].index("downstairs")
+    logits[peak] = 2.0
+    logits[peak - 1] = 0.5  # "is" is marked too; the unmarked "cloakroom" is not
+    analysis = Analysis(starts, None, None, logits)
+    start, end = trigger_span(text, analysis, act)
+    assert text[start:end] == "is downstairs"
+    logits[:] = 1.0  # everything marked: capped at six words
+    start, end = trigger_span(text, analysis, act, max_words=6)
+    assert len(text[start:end].split()) == 6 and "downstairs" in text[start:end]
+    assert act[0] <= start and end <= act[1]
+    logits[:] = -1.0
+    logits[-1] = 3.0  # the peak on the final full stop: the last word carries the trigger
+    starts.append(len(text) - 1)
+    analysis = Analysis(starts, None, None, np.append(logits, 5.0))
+    start, end = trigger_span(text, analysis, (0, len(text)))
+    assert text[start:end] == "left"
 
 
 def test_segments_keep_spans_and_boundary_strength():
@@ -41,26 +88,32 @@ def test_segments_keep_spans_and_boundary_strength():
 
 @pytest.fixture(scope="module")
 def planner(tmp_path_factory):
-    from emopose.planners.local import LocalPlanner
+    """The configured local planner (same training files and cache as the app) on a copy of the library."""
+    from hydra import compose, initialize_config_dir
+
+    from emopose.build import make
+    from emopose.config import CONFIG_DIR
 
     folder = tmp_path_factory.mktemp("lib") / "g1"
     shutil.copytree(PROJECT_ROOT / "library/g1", folder)
     library = MotionLibrary.from_config(paths=[str(folder)], limits=str(folder / "limits.yaml"),
                                         write_dir=str(folder))
-    return LocalPlanner(library, TRAIN_FILES)
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=["planner=local"])
+    return make(cfg.planner, "planner", library=library)
 
 
 @pytest.mark.slow
 def test_quality_floor_on_held_out_training_slice(planner):
-    from emopose.planners.local_model import load_training
+    from emopose.jobs.train_local import held_out_metrics
+    from emopose.planners.local_data import load_examples
 
-    held_out = load_training(planner.train_files, planner.model.config.holdout_percent, held_out=True)
-    assert len(held_out) > 150
-    _, proba = planner.model.encode_and_classify([i.text for i in held_out])
-    from emopose import CLASSES
-
-    accuracy = sum(CLASSES[k] == i.label for k, i in zip(proba.argmax(1), held_out)) / len(held_out)
-    assert accuracy >= 0.72, f"held-out accuracy {accuracy:.3f}"
+    held_out = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
+    metrics = held_out_metrics(planner, held_out, [planner.score(e.text) for e in held_out])
+    assert metrics["singles"] > 150 and metrics["sequences"] >= 15
+    assert metrics["single_top1"] >= 0.75, metrics
+    assert metrics["sequence_exact"] >= 0.5, metrics
+    assert metrics["anchor_recall"] >= 0.6, metrics
 
 
 @pytest.mark.slow
