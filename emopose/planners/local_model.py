@@ -1,4 +1,4 @@
-"""The local planner's model: all-MiniLM-L6-v2 with its top layers fine-tuned, and three small heads.
+"""The local planner's model: all-MiniLM-L6-v2, fine-tuned, and four small heads.
 
 One forward pass over an utterance gives contextual token states; everything else pools them:
 
@@ -7,12 +7,14 @@ One forward pass over an utterance gives contextual token states; everything els
 - boundary head: whether a new communicative act starts at a candidate segment boundary, from the
   states of the segments on either side;
 - anchor head: per token, whether it belongs to the phrase that carries the act (the trigger);
-- variant projection: maps an act's semantic vector (frozen layers) towards the library description
-  of the motion annotated for it. Variants are scored against the live descriptions, so a new or
+- variant projection: maps an act's semantic vector (states below the fine-tuned layers) towards the
+  library description of the motion annotated for it. Variants are scored against the live descriptions, so a new or
   edited motion is selectable without retraining (the projection is general, not per motion).
 
 Trained on experiments/train/ only, never on a benchmark suite (planners/local_data.py builds the
-examples). The lower layers stay frozen; the result (top layers + heads, a few MB) is cached on disk
+examples). The top `trainable_layers` are fine-tuned (all six by default; fewer train faster) and the
+"semantic" states the variant choice uses are taken below them (with all six trained, the token
+embeddings, which the variant projection maps into the description space). The result is cached on disk
 under a key of the training files' contents and the hyper-parameters: the first use trains once, later
 runs load it. `python -m emopose +experiment=train_local` retrains and reports held-out quality.
 """
@@ -45,7 +47,7 @@ class TrainingConfig:
     holdout_percent: int = 10  # items whose id hashes into this bucket are held out
     synthetic_sequences: int = 1000  # joined single-act items added as multi-act examples
     epochs: int = 3
-    trainable_layers: int = 3
+    trainable_layers: int = 6
     lr: float = 5e-5
     head_lr: float = 2e-3
     batch_size: int = 32
@@ -61,7 +63,7 @@ class Analysis:
 
     starts: list[int]
     class_states: object  # torch (T, D), fine-tuned top
-    semantic_states: object  # torch (T, D), last frozen layer
+    semantic_states: object  # torch (T, D), below the fine-tuned layers
     anchor_logits: np.ndarray  # (T,)
 
     def token_range(self, start: int, end: int) -> tuple[int, int]:
@@ -134,7 +136,7 @@ class ActModel:
         return dict(batch), starts, real
 
     def _encode(self, body, inputs: dict) -> tuple:
-        """(class states from the fine-tuned top, semantic states from the last frozen layer), (B, T, D)."""
+        """(class states from the fine-tuned top, semantic states from below the fine-tuned layers), (B, T, D)."""
         out = body(**inputs, output_hidden_states=True)
         return out.last_hidden_state, out.hidden_states[-1 - self.config.trainable_layers]
 
@@ -189,12 +191,19 @@ class ActModel:
             return eager
         return lambda inputs: traced(*(inputs[n] for n in names))
 
-    def analyse(self, texts: list[str]) -> list[Analysis]:
+    def prepare_inference(self) -> None:
+        """Build the inference encoder now (load time) rather than inside the first plan's latency."""
         import torch
 
         with self._lock, torch.inference_mode():
             if self._encoder is None:
                 self._encoder = self._inference_encoder()
+
+    def analyse(self, texts: list[str]) -> list[Analysis]:
+        import torch
+
+        self.prepare_inference()
+        with self._lock, torch.inference_mode():
             inputs, starts, real = self._tokens(texts)
             class_states, semantic = self._encoder(inputs)
             out = []
@@ -232,7 +241,7 @@ class ActModel:
             return torch.nn.functional.normalize(out, dim=-1).numpy()
 
     def embed(self, texts: list[str]) -> np.ndarray:
-        """Normalised semantic (frozen-layer) sentence embeddings, (N, D)."""
+        """Normalised semantic sentence embeddings (states below the fine-tuned layers), (N, D)."""
         return np.stack([pooled(a.semantic_states, [(0, len(a.starts))])[0].numpy()
                          for a in self.analyse(texts)]) if texts else np.zeros((0, 384))
 
@@ -353,6 +362,7 @@ def load_or_train(paths: list[str], cache_dir: str | Path, config: TrainingConfi
     model = ActModel(config, bf16_inference, trace_inference)
     if artifact.is_file():
         model.load_state(torch.load(artifact, weights_only=True))
+        model.prepare_inference()
         return model
     log.warning("training the local planner on %s (first use, a few minutes on 2 cores; cached at %s)",
                 [Path(p).name for p in paths], artifact)
@@ -362,4 +372,5 @@ def load_or_train(paths: list[str], cache_dir: str | Path, config: TrainingConfi
     tmp = artifact.with_suffix(".tmp")
     torch.save(model.state(), tmp)
     tmp.replace(artifact)
+    model.prepare_inference()
     return model
