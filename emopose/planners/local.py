@@ -84,7 +84,7 @@ class LocalPlanner:
 
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
                  training: dict | None = None, min_words: int = 2, temperature: float = 3.0,
-                 boundary_weight: float = 0.5, act_cost: float = -0.75, max_records: int = 4,
+                 boundary_weight: float = 0.5, act_cost: float = -1.0, max_records: int = 4,
                  context_weight: float = 0.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
         self.library = library
         self.train_files = list(train_files)

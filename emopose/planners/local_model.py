@@ -46,7 +46,7 @@ MAX_TOKENS = 128
 class TrainingConfig:
     holdout_percent: int = 10  # items whose id hashes into this bucket are held out
     synthetic_sequences: int = 1000  # joined single-act items added as multi-act examples
-    epochs: int = 3
+    epochs: int = 4
     trainable_layers: int = 6
     lr: float = 5e-5
     head_lr: float = 2e-3
