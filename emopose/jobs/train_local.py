@@ -51,17 +51,26 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
 class TrainLocalJob:
     search: dict[str, list[float]] | None = None  # split parameter -> values to try
 
-    def __call__(self, ctx: RunContext) -> dict:
-        planner = ctx.planner
-        if not isinstance(planner, LocalPlanner):
-            raise ValueError("train_local needs planner=local")
+    def __post_init__(self) -> None:
+        """Check job.search when the job is built, before the context (and any training) is."""
         search = self.search or {}
         unknown = set(search) - set(SPLIT_PARAMETERS)
         if unknown:
             raise ValueError(f"job.search: unknown split parameters {sorted(unknown)}; use {SPLIT_PARAMETERS}")
+        not_lists = [name for name, values in search.items()
+                     if not isinstance(values, list) or not all(isinstance(v, int | float) for v in values)]
+        if not_lists:
+            raise ValueError(f"job.search: {not_lists} must each be a list of numbers, "
+                             "e.g. job.search={act_cost:[-1.0,-0.5]}")
+
+    def __call__(self, ctx: RunContext) -> dict:
+        planner = ctx.planner
+        if not isinstance(planner, LocalPlanner):
+            raise ValueError("train_local needs planner=local")
         examples = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
         scored = [planner.score(e.text) for e in examples]
         configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
+        search = self.search or {}
         grid = [dict(zip(search, values)) for values in itertools.product(*search.values())]
         rows = []
         try:

@@ -102,8 +102,11 @@ class LocalPlanner:
             raw = json.dumps({"reply": request.utterance, "gestures": gestures})
         return PlannerOutput(raw=raw, latency_s=clock.elapsed)
 
-    def acts(self, utterance: str, history: tuple[dict, ...] = ()) -> tuple[Analysis, list[_Act]]:
-        """The best split of the utterance into acts (see best_split), at most max_records of them."""
+    def acts(self, utterance: str, history: tuple[dict, ...] = ()) -> tuple[Analysis | None, list[_Act]]:
+        """The best split of the utterance into acts (see best_split), at most max_records of them.
+        A blank utterance has no acts (and nothing to analyse)."""
+        if not utterance.strip():
+            return None, []
         scored = self.score(utterance, history)
         return scored.analysis, self.best_split(scored)[: self.max_records]
 

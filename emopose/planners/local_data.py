@@ -90,8 +90,9 @@ _JOINERS = [(". ", False), ("! ", False), ("? ", False), ("... ", False), ("; ",
             (", ", True), (": ", True)]
 
 
-def synthetic_sequence(parts: list[Example], rng: random.Random, item_id: str) -> Example:
-    """Join single-act examples into one utterance; acts follow the parts."""
+def synthetic_sequence(parts: list[Example], rng: random.Random, item_id: str) -> Example | None:
+    """Join single-act examples into one utterance; acts follow the parts. None when a part has no
+    segment of its own (a joiner merged it into a neighbour's), so no act boundary can be placed."""
     text, spans = "", []
     for k, part in enumerate(parts):
         body = part.text.strip()
@@ -114,8 +115,8 @@ def synthetic_sequence(parts: list[Example], rng: random.Random, item_id: str) -
     acts = []
     for k, part in enumerate(parts):
         mine = [p for p in pieces if part_of(p) == k]
-        if not mine:  # a part swallowed by a neighbour's segment: not a usable example
-            return single_act(item_id, text, parts[0].acts[0].label)
+        if not mine:
+            return None
         acts.append(Act(mine[0].start, mine[-1].end, part.acts[0].label))
     return Example(item_id, text, acts, pieces)
 
@@ -135,7 +136,7 @@ def synthetic_sequences(singles: list[Example], count: int, seed: int) -> list[E
             if not labels or label != labels[-1]:
                 labels.append(label)
         example = synthetic_sequence([rng.choice(by_class[c]) for c in labels], rng, f"synthetic-{n}")
-        if len(example.acts) == length:
+        if example is not None:
             out.append(example)
     return out
 

@@ -96,7 +96,7 @@ def boundary_features(class_states, piece_ranges: list[tuple[int, int]]):
 
 
 class ActModel:
-    """MiniLM + act / boundary / anchor heads. Thread-safe inference."""
+    """MiniLM + act / boundary / anchor heads and the variant projection. Thread-safe inference."""
 
     def __init__(self, config: TrainingConfig, bf16_inference: bool = False, trace_inference: bool = False) -> None:
         os.environ.setdefault("HF_HUB_OFFLINE", "1")  # before transformers reads it: never reach for a hub
@@ -243,7 +243,7 @@ class ActModel:
     def embed(self, texts: list[str]) -> np.ndarray:
         """Normalised semantic sentence embeddings (states below the fine-tuned layers), (N, D)."""
         return np.stack([pooled(a.semantic_states, [(0, len(a.starts))])[0].numpy()
-                         for a in self.analyse(texts)]) if texts else np.zeros((0, 384))
+                         for a in self.analyse(texts)]) if texts else np.zeros((0, self.body.config.hidden_size))
 
     def fit(self, examples: list[Example], catalogue: dict[str, tuple[str, str]] | None = None) -> None:
         """Train on the examples; catalogue (motion name -> (class, description text)) supervises the

@@ -77,6 +77,16 @@ def test_trigger_is_the_marked_run_of_whole_words_around_the_peak():
     assert text[start:end] == "left"
 
 
+def test_train_local_search_is_checked_before_anything_is_built():
+    from emopose.jobs.train_local import TrainLocalJob
+
+    assert TrainLocalJob(search={"act_cost": [-1.0, -0.5], "temperature": [2, 3]}).search
+    with pytest.raises(ValueError, match="unknown split parameters"):
+        TrainLocalJob(search={"epochs": [3]})
+    with pytest.raises(ValueError, match="list of numbers"):
+        TrainLocalJob(search={"act_cost": -1.0})
+
+
 def test_segments_keep_spans_and_boundary_strength():
     text = "Welcome in, everyone! The robot arm is over there, and it is fragile."
     pieces = segments(text)
@@ -126,6 +136,12 @@ def test_ordered_plan_with_triggers_from_the_reply(planner):
     for record in plan.records:
         assert record.trigger and record.trigger in text
         assert planner.library.get(record.variant).cls == record.cls
+
+
+@pytest.mark.slow
+def test_blank_utterance_gets_a_plan_without_gestures(planner):
+    for text in ("", "   \n"):
+        assert json.loads(planner.plan(PlanRequest(text)).raw) == {"reply": text, "gestures": []}
 
 
 @pytest.mark.slow
