@@ -2,8 +2,8 @@
 
 1. Cut the utterance into candidate segments (planners/segment.py) and run the model once over the
    utterance (and, with dialogue history, once more over the utterance read after the previous turn).
-2. Choose the split into acts: contiguous groups of segments maximising the acts' class log
-   probabilities plus the boundary head's logits at the chosen boundaries (neighbouring acts differ).
+2. Choose the split into acts: the best split of a semi-Markov CRF over the segments (act class
+   logits plus boundary logits at the chosen boundaries; neighbouring acts differ), trained as one.
 3. Per act: the variant is the class member whose library description is most similar to the act's
    text (descriptions come from the live library, so a new variant is selectable without retraining);
    intensity from cues (intensifiers and exclamations up, hedges down); trigger = the words the anchor
@@ -20,6 +20,7 @@ import numpy as np
 
 from emopose import CLASSES
 from emopose.library import MotionLibrary
+from emopose.planners import semi_crf
 from emopose.planners.base import PlannerOutput, PlanRequest, timed
 from emopose.planners.local_model import Analysis, TrainingConfig, load_or_train
 from emopose.planners.segment import Segment, segments
@@ -65,7 +66,7 @@ class ScoredUtterance:
     analysis: Analysis
     pieces: list[Segment]
     spans: list[tuple[int, int]]  # candidate acts: piece index ranges [i, j)
-    probas: np.ndarray  # (spans, classes)
+    logits: np.ndarray  # (spans, classes) unnormalised class scores
     vectors: np.ndarray  # (spans, D) semantic vectors, for the variant choice
     boundaries: np.ndarray  # (pieces - 1,) logit that a new act starts before pieces[k + 1]
 
@@ -79,12 +80,17 @@ class _Act:
     vector: np.ndarray
 
 
+def softmax(logits: np.ndarray) -> np.ndarray:
+    shifted = np.exp(logits - logits.max(axis=-1, keepdims=True))
+    return shifted / shifted.sum(axis=-1, keepdims=True)
+
+
 class LocalPlanner:
     name = "local"
 
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
-                 training: dict | None = None, min_words: int = 2, temperature: float = 3.0,
-                 boundary_weight: float = 0.5, act_cost: float = -1.0, max_records: int = 4,
+                 training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
+                 boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
                  context_weight: float = 0.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
         self.library = library
         self.train_files = list(train_files)
@@ -118,47 +124,29 @@ class LocalPlanner:
         analyses = self.model.analyse([utterance] + ([previous + utterance] if history else []))
         spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)
                  if j - i == n or sum(p.words for p in pieces[i:j]) >= self.min_words]
-        probas, vectors = self.model.classify_spans(analyses[0], [(pieces[i].start, pieces[j - 1].end)
+        logits, vectors = self.model.classify_spans(analyses[0], [(pieces[i].start, pieces[j - 1].end)
                                                                   for i, j in spans])
         if history:
             whole = spans.index((0, n))
             in_context, _ = self.model.classify_spans(analyses[1], [(0, len(previous) + len(utterance))])
-            probas[whole] = self._with_context(probas[whole], in_context[0])
+            logits[whole] = self._with_context(logits[whole], in_context[0])
         boundaries = self.model.boundary_logits(analyses[0], pieces)
-        return ScoredUtterance(analyses[0], pieces, spans, probas, vectors, boundaries)
+        return ScoredUtterance(analyses[0], pieces, spans, logits, vectors, boundaries)
 
     def best_split(self, scored: ScoredUtterance) -> list[_Act]:
-        """Maximise sum over acts of log p(class | act) / temperature (renormalised) plus, per chosen
-        boundary, boundary_weight * its logit - act_cost; neighbouring acts have different classes."""
-        pieces, spans, probas, vectors = scored.pieces, scored.spans, scored.probas, scored.vectors
-        log_p = np.log(np.maximum(probas, 1e-12)) / self.temperature
-        log_p -= np.log(np.exp(log_p).sum(axis=1, keepdims=True))
-        # best[j][c]: score of the best split of pieces[:j] whose last act has class c.
-        best = np.full((len(pieces) + 1, len(CLASSES)), -np.inf)
-        back: dict[tuple[int, int], tuple[int, int, int]] = {}
-        best[0, :] = 0.0
-        for k, (i, j) in enumerate(spans):
-            opening = self.boundary_weight * scored.boundaries[i - 1] - self.act_cost if i else 0.0
-            for c in range(len(CLASSES)):
-                before = best[i].copy()
-                if i > 0:
-                    before[c] = -np.inf  # neighbouring acts differ in class
-                prev = int(np.argmax(before))
-                score = before[prev] + log_p[k, c] + opening
-                if score > best[j, c]:
-                    best[j, c], back[(j, c)] = score, (i, prev, k)
-        acts, j, c = [], len(pieces), int(np.argmax(best[len(pieces)]))
-        while j > 0:
-            i, prev, k = back[(j, c)]
-            acts.append(_Act(pieces[i].start, pieces[j - 1].end, CLASSES[c], probas[k], vectors[k]))
-            j, c = i, prev
-        return acts[::-1]
+        """The semi-CRF's best split (planners/semi_crf.py): act scores are the class logits / temperature,
+        an act starting inside the utterance adds boundary_weight * its boundary logit - act_cost.
+        The model is trained with (1, 1, 0); the knobs are for the held-out sweep in train_local."""
+        pieces, spans = scored.pieces, scored.spans
+        openings = self.boundary_weight * scored.boundaries - self.act_cost
+        split = semi_crf.best_split(len(pieces), spans, scored.logits / self.temperature, openings)
+        return [_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, CLASSES[c],
+                     softmax(scored.logits[k]), scored.vectors[k]) for k, c in split]
 
     def _with_context(self, own: np.ndarray, in_context: np.ndarray) -> np.ndarray:
-        """Geometric mix of the utterance's own class distribution and that of the utterance read
-        after the previous dialogue turn: elliptical replies ("That one.") borrow meaning from it."""
-        mixed = own * in_context**self.context_weight
-        return mixed / mixed.sum()
+        """The utterance's own class logits plus context_weight times the log-probabilities of the
+        utterance read after the previous dialogue turn: elliptical replies ("That one.") borrow meaning."""
+        return own + self.context_weight * np.log(softmax(in_context))
 
     def _record(self, act: _Act, analysis: Analysis, utterance: str) -> dict:
         text = utterance[act.start:act.end]

@@ -48,6 +48,15 @@ class Example:
         starts = {a.start for a in self.acts}
         return [int(p.start in starts) for p in self.pieces[1:]]
 
+    def gold_split(self) -> list[tuple[tuple[int, int], str]] | None:
+        """The acts as (segment range [i, j), class), or None when neighbouring acts share a class
+        (the split model forbids that)."""
+        if any(a.label == b.label for a, b in zip(self.acts, self.acts[1:])):
+            return None
+        first = {p.start: k for k, p in enumerate(self.pieces)}
+        last = {p.end: k for k, p in enumerate(self.pieces)}
+        return [((first[a.start], last[a.end] + 1), a.label) for a in self.acts]
+
 
 def is_held_out(item_id: str, percent: int) -> bool:
     """A stable split by id: the same items are held out on every machine and run."""

@@ -36,9 +36,10 @@ import numpy as np
 from emopose import CLASSES
 from emopose.planners.local_data import Example, load_examples
 from emopose.planners.segment import Segment
+from emopose.planners.semi_crf import log_partition, split_score
 
 log = logging.getLogger(__name__)
-ARTIFACT_VERSION = 5
+ARTIFACT_VERSION = 6
 MAX_TOKENS = 128
 
 
@@ -54,6 +55,7 @@ class TrainingConfig:
     logit_scale: float = 20.0
     anchor_loss_weight: float = 0.5
     variant_loss_weight: float = 0.5
+    split_loss_weight: float = 1.0  # the semi-CRF likelihood of the annotated split (planners/semi_crf.py)
     seed: int = 0
 
 
@@ -214,13 +216,14 @@ class ActModel:
         return out
 
     def classify_spans(self, analysis: Analysis, spans: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
-        """(class probabilities (S, 8), semantic vectors (S, D)) of character spans of the text."""
+        """(class logits (S, 8), semantic vectors (S, D)) of character spans of the text. The logits are
+        unnormalised: the split model compares them across spans, softmax gives class probabilities."""
         import torch
 
         ranges = [analysis.token_range(a, b) for a, b in spans]
         with torch.inference_mode():
             logits = self.act_head(pooled(analysis.class_states, ranges)) * self.config.logit_scale
-            return torch.softmax(logits, -1).numpy(), pooled(analysis.semantic_states, ranges).numpy()
+            return logits.numpy(), pooled(analysis.semantic_states, ranges).numpy()
 
     def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
         """Logit that a new act starts before pieces[k], for k = 1 .. len(pieces) - 1."""
@@ -294,6 +297,7 @@ class ActModel:
         act_vectors, act_labels, features, boundary_labels, anchor_logits, anchor_labels = [], [], [], [], [], []
         variant_logits: list = []
         variant_labels: list[int] = []
+        split_losses = []
         for k, example in enumerate(batch):
             states = class_states[k, real[k]]
             analysis = Analysis(starts[k], states, None, np.zeros(0))
@@ -308,24 +312,38 @@ class ActModel:
                     variant_logits.append(candidates @ vector * self.config.logit_scale)
                     variant_labels.append(members.index(variant))
             act_labels += [CLASSES.index(a.label) for a in example.acts]
+            openings = states.new_zeros(0)
             if len(example.pieces) > 1:
                 ranges = [analysis.token_range(p.start, p.end) for p in example.pieces]
-                features.append(boundary_features(states, ranges))
+                openings = self.boundary_head(boundary_features(states, ranges)).squeeze(-1)
+                features.append(openings)
                 boundary_labels += example.boundaries
+            if self.config.split_loss_weight and example.gold_split() is not None:
+                split_losses.append(self._split_nll(example, analysis, openings))
             if example.anchors:
                 anchor_logits.append(self.anchor_head(states).squeeze(-1))
                 anchor_labels += [float(any(a <= s < b for a, b in example.anchors)) for s in starts[k]]
         logits = self.act_head(torch.cat(act_vectors)) * self.config.logit_scale
         loss = cross_entropy(logits, torch.tensor(act_labels))
         if features:
-            loss = loss + bce(self.boundary_head(torch.cat(features)).squeeze(-1), torch.tensor(boundary_labels,
-                                                                                            dtype=torch.float32))
+            loss = loss + bce(torch.cat(features), torch.tensor(boundary_labels, dtype=torch.float32))
+        if split_losses:
+            loss = loss + self.config.split_loss_weight * torch.stack(split_losses).mean()
         if anchor_logits:
             loss = loss + self.config.anchor_loss_weight * bce(torch.cat(anchor_logits), torch.tensor(anchor_labels))
         for logits_k, label in zip(variant_logits, variant_labels):  # classes differ in member count
             loss = loss + self.config.variant_loss_weight * cross_entropy(
                 logits_k.unsqueeze(0), torch.tensor([label])) / len(variant_labels)
         return loss
+
+    def _split_nll(self, example: Example, analysis: Analysis, openings):
+        """-log P(annotated split | utterance) under the semi-CRF over every split of its segments."""
+        pieces, n = example.pieces, len(example.pieces)
+        spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)]
+        ranges = [analysis.token_range(pieces[i].start, pieces[j - 1].end) for i, j in spans]
+        span_scores = self.act_head(pooled(analysis.class_states, ranges)) * self.config.logit_scale
+        gold = [(spans.index(span), CLASSES.index(label)) for span, label in example.gold_split()]
+        return log_partition(n, spans, span_scores, openings) - split_score(gold, spans, span_scores, openings)
 
     def state(self) -> dict:
         n = len(self.body.encoder.layer)
