@@ -32,6 +32,8 @@ class MujocoBase:
         self.velocity_std, self.yaw_rate_std = velocity_std, yaw_rate_std
         self.rest_speed = rest_speed
         self._rng = np.random.default_rng(seed)
+        self._commanded = False  # a non-zero velocity command is in force
+        self._settled = True  # at rest since the last stop (arm reactions at a stop are not walking)
         self._odom = self.true_pose()
         self.travelled_m = 0.0
 
@@ -58,6 +60,7 @@ class MujocoBase:
             data.qvel[adr] = 0.0
         mujoco.mj_forward(self.backend.model, data)
         self._odom = pose
+        self._commanded, self._settled = False, True
 
     # -- MobileBase ----------------------------------------------------------------------------
     def odometry(self) -> Pose2D:
@@ -65,15 +68,23 @@ class MujocoBase:
 
     def command(self, vx: float, wz: float) -> None:
         self.backend.set_base_velocity(float(vx), 0.0, float(wz))
+        self._commanded, self._settled = (vx, wz) != (0.0, 0.0), False
 
     def stop(self) -> None:
         self.backend.set_base_velocity(0.0, 0.0, 0.0)
+        self._commanded, self._settled = False, False
 
     def moving(self) -> bool:
+        """Walking: a velocity command is in force, or the base has not yet come to rest after the last
+        one. Once at rest, the sway the arms' reaction forces give the simulated base does not count."""
+        return self._commanded or not (self._settled or self._at_rest())
+
+    def _at_rest(self) -> bool:
         vx, vy, wz = self.true_velocity()
-        return math.hypot(vx, vy) > self.rest_speed or abs(wz) > 2 * self.rest_speed
+        return math.hypot(vx, vy) <= self.rest_speed and abs(wz) <= 2 * self.rest_speed
 
     def after_tick(self, dt: float) -> None:
+        self._settled = self._settled or (not self._commanded and self._at_rest())
         vx, vy, wz = self.true_velocity()
         if self.velocity_std or self.yaw_rate_std:
             moving = math.hypot(vx, vy) > 1e-3 or abs(wz) > 1e-3  # no drift while standing still

@@ -76,6 +76,29 @@ def test_mujoco_base_reaches_the_four_lab_stops():
         assert leg.odometry_error_m == pytest.approx(truth.distance_to(leg.goal), abs=0.005)  # no noise
 
 
+def test_walking_is_a_command_in_force_not_the_sway_of_gesturing_arms():
+    backend = MujocoBackend(planar_base=True)
+    q0 = backend.connect(None)
+    base = MujocoBase(backend)
+
+    def advance(periods: int = 1) -> None:
+        for _ in range(periods):
+            backend.send(0.0, q0)
+            base.after_tick(0.02)
+
+    base.command(0.2, 0.0)
+    advance(10)
+    assert base.moving()
+    base.stop()
+    assert base.moving()  # still coasting: not yet at rest after the stop
+    advance(50)
+    assert not base.moving()
+    backend.data.qvel[backend.model.joint("base_x").dofadr[0]] = 0.05  # the arms' reaction push at a stop
+    assert base.true_velocity()[0] > base.rest_speed and not base.moving()
+    base.command(0.0, 0.3)
+    assert base.moving()
+
+
 def test_noisy_odometry_is_seeded_and_still_within_tolerance():
     finals = []
     for _ in range(2):
