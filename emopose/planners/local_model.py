@@ -2,10 +2,12 @@
 
 One forward pass over an utterance gives contextual token states; everything else pools them:
 
-- act head: class probabilities of any candidate act (a character span), from the normalised mean of
-  its token states (one cumulative sum serves every span);
+- act head: class logits of any candidate act (a character span), from the normalised mean of its
+  token states (one cumulative sum serves every span);
 - boundary head: whether a new communicative act starts at a candidate segment boundary, from the
   states of the segments on either side;
+  the two are also the potentials of a semi-Markov CRF over the segments (planners/semi_crf.py), trained
+  on the likelihood of the annotated split against every other split, which is how the planner splits;
 - anchor head: per token, whether it belongs to the phrase that carries the act (the trigger);
 - variant projection: maps an act's semantic vector (states below the fine-tuned layers) towards the
   library description of the motion annotated for it. Variants are scored against the live descriptions, so a new or
