@@ -13,6 +13,8 @@ from __future__ import annotations
 import itertools
 from dataclasses import dataclass
 
+from emopose.bench.sequence_metrics import SequencePrediction, item_scores
+from emopose.bench.suites import SequenceItem
 from emopose.context import RunContext
 from emopose.jobs.report import markdown_table, write_results
 from emopose.planners.local import LocalPlanner, ScoredUtterance, trigger_span
@@ -23,23 +25,27 @@ SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
 
 def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: list[ScoredUtterance]) -> dict:
     """Single-act top-1 and kept-whole rate; multi-act ordered exact, anchor recall and exact-variant
-    match (per annotated position, as in the sequence suite). Fractions."""
+    match, scored as the sequence suite scores them (emopose.bench.sequence_metrics). Fractions."""
     single_hits = single_whole = sequences = exact = anchors = anchor_hits = variant_hits = 0
     for example, scores in zip(examples, scored):
         acts = planner.best_split(scores)[: planner.max_records]
-        classes = [a.cls for a in acts]
-        gold = [a.label for a in example.acts]
+        classes = tuple(a.cls for a in acts)
+        gold = tuple(a.label for a in example.acts)
         if len(gold) == 1:
             single_hits += classes[0] == gold[0]
             single_whole += len(classes) == 1
             continue
+        item = SequenceItem(example.id, example.text, gold, tuple(example.text[a:b] for a, b in example.anchors),
+                            tuple(example.variants))
+        triggers = tuple(example.text[slice(*trigger_span(example.text, scores.analysis, (a.start, a.end)))]
+                         for a in acts)
+        result = item_scores(item, SequencePrediction(classes, triggers,
+                                                      tuple(planner.variant(a.cls, a.vector) for a in acts)))
         sequences += 1
-        exact += classes == gold
-        spans = [trigger_span(example.text, scores.analysis, (a.start, a.end)) for a in acts]
-        anchors += len(example.anchors)
-        anchor_hits += sum(any(s < b and a < e for s, e in spans) for a, b in example.anchors)
-        predicted = [planner.variant(a.cls, a.vector) for a in acts]
-        variant_hits += sum(k < len(predicted) and predicted[k] == v for k, v in enumerate(example.variants))
+        exact += result["exact"]
+        anchors += len(item.anchors)
+        anchor_hits += result["anchors_hit"]
+        variant_hits += result["variants_hit"]
     singles = len(examples) - sequences
     return {"single_top1": single_hits / max(1, singles), "single_kept_whole": single_whole / max(1, singles),
             "sequence_exact": exact / max(1, sequences), "anchor_recall": anchor_hits / max(1, anchors),

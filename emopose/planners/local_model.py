@@ -320,8 +320,9 @@ class ActModel:
                 openings = self.boundary_head(boundary_features(states, ranges)).squeeze(-1)
                 features.append(openings)
                 boundary_labels += example.boundaries
-            if self.config.split_loss_weight and example.gold_split() is not None:
-                split_losses.append(self._split_nll(example, analysis, openings))
+            gold = example.gold_split() if self.config.split_loss_weight else None
+            if gold is not None:
+                split_losses.append(self._split_nll(example, gold, analysis, openings))
             if example.anchors:
                 anchor_logits.append(self.anchor_head(states).squeeze(-1))
                 anchor_labels += [float(any(a <= s < b for a, b in example.anchors)) for s in starts[k]]
@@ -338,14 +339,14 @@ class ActModel:
                 logits_k.unsqueeze(0), torch.tensor([label])) / len(variant_labels)
         return loss
 
-    def _split_nll(self, example: Example, analysis: Analysis, openings):
-        """-log P(annotated split | utterance) under the semi-CRF over every split of its segments."""
+    def _split_nll(self, example: Example, gold: list[tuple[tuple[int, int], str]], analysis: Analysis, openings):
+        """-log P(gold split | utterance) under the semi-CRF over every split of its segments."""
         pieces, n = example.pieces, len(example.pieces)
         spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)]
         ranges = [analysis.token_range(pieces[i].start, pieces[j - 1].end) for i, j in spans]
         span_scores = self.act_head(pooled(analysis.class_states, ranges)) * self.config.logit_scale
-        gold = [(spans.index(span), CLASSES.index(label)) for span, label in example.gold_split()]
-        return log_partition(n, spans, span_scores, openings) - split_score(gold, spans, span_scores, openings)
+        acts = [(spans.index(span), CLASSES.index(label)) for span, label in gold]
+        return log_partition(n, spans, span_scores, openings) - split_score(acts, spans, span_scores, openings)
 
     def state(self) -> dict:
         n = len(self.body.encoder.layer)
