@@ -35,7 +35,7 @@ def make(node: Any, key: str, **kwargs: Any) -> Any:
         # config, and OmegaConf turns a dataclass instance (MotionLibrary, TrajectoryBuilder) into a config node.
         factory = instantiate(node, _convert_="all", _partial_=True)
         return factory(**kwargs)
-    except (InstantiationException, TypeError) as exc:
+    except (InstantiationException, TypeError, ValueError) as exc:  # a bad value the target rejected
         cause = exc.__cause__ or exc
         raise ConfigError(f"cannot build '{key}' ({OmegaConf.select(node, '_target_')}): {cause}") from exc
 

@@ -92,6 +92,8 @@ class LocalPlanner:
                  training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
                  boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
                  context_weight: float = 0.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
+        if not temperature > 0:
+            raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         self.library = library
         self.train_files = list(train_files)
         self.model = load_or_train(list(train_files), cache_dir, TrainingConfig(**(training or {})), bf16_inference,

@@ -30,7 +30,7 @@ import logging
 import os
 import random
 import threading
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -59,6 +59,20 @@ class TrainingConfig:
     variant_loss_weight: float = 0.5
     split_loss_weight: float = 1.0  # the semi-CRF likelihood of the annotated split (planners/semi_crf.py)
     seed: int = 0
+
+    def __post_init__(self) -> None:
+        """A wrong override is a one-line error here, before the cache key is taken or training starts."""
+        for f in fields(self):
+            value = getattr(self, f.name)
+            wanted = int if f.type == "int" else (int, float)
+            if isinstance(value, bool) or not isinstance(value, wanted):
+                raise ValueError(f"planner.training.{f.name} must be a{'n integer' if f.type == 'int' else ' number'}"
+                                 f", got {value!r}")
+            if f.name != "seed" and value < 0:
+                raise ValueError(f"planner.training.{f.name} must not be negative, got {value!r}")
+        if not 0 <= self.holdout_percent < 100 or min(self.epochs, self.batch_size, self.trainable_layers) < 1:
+            raise ValueError("planner.training: holdout_percent must be in [0, 100); epochs, batch_size and "
+                             f"trainable_layers at least 1 (got {self})")
 
 
 @dataclass

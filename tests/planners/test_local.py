@@ -87,6 +87,26 @@ def test_train_local_search_is_checked_before_anything_is_built():
         TrainLocalJob(search={"act_cost": -1.0})
 
 
+@pytest.mark.parametrize("override, message", [
+    ("planner.training.split_loss_weight=abc", "split_loss_weight must be a number, got 'abc'"),
+    ("planner.training.seed=1.5", "seed must be an integer"),
+    ("planner.training.epochs=0", "epochs, batch_size and trainable_layers at least 1"),
+    ("planner.training.lr=-0.1", "lr must not be negative"),
+    ("planner.temperature=0", "temperature must be positive"),
+])
+def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message):
+    from hydra import compose, initialize_config_dir
+
+    from emopose.build import ConfigError, make
+    from emopose.config import CONFIG_DIR
+
+    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
+        cfg = compose("config", overrides=["planner=local", f"planner.cache_dir={tmp_path}", override])
+    with pytest.raises(ConfigError, match=re.escape(message)):
+        make(cfg.planner, "planner", library=make(cfg.library, "library"))
+    assert not list(tmp_path.iterdir())  # nothing trained, nothing cached
+
+
 def test_segments_keep_spans_and_boundary_strength():
     text = "Welcome in, everyone! The robot arm is over there, and it is fragile."
     pieces = segments(text)
