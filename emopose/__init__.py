@@ -15,6 +15,7 @@ CLASSES: tuple[str, ...] = (
     "comforting",
     "neutral",
 )
-NUM_JOINTS = 14
-CONTROL_HZ = 50.0
-CONTROL_DT = 1.0 / CONTROL_HZ
+# Re-exported so `from emopose import CONTROL_DT` keeps working; the G1 spec module owns them.
+from emopose.robot.g1_spec import CONTROL_DT, CONTROL_HZ, NUM_JOINTS  # noqa: E402
+
+__all__ = ["CLASSES", "CONTROL_DT", "CONTROL_HZ", "NUM_JOINTS"]

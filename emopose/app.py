@@ -1,4 +1,4 @@
-"""Run one composed config: build the context and the job, run it, always release the robot."""
+"""Run one composed config: build the resources, session, runner and job, run it, always release the robot."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from pathlib import Path
 
 from omegaconf import DictConfig
 
-from emopose.build import build_context, build_job
+from emopose.build import build_job, build_run
 
 log = logging.getLogger(__name__)
 
@@ -16,5 +16,5 @@ def run(cfg: DictConfig, run_dir: str | Path) -> dict:
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
     job = build_job(cfg)
-    with build_context(cfg, run_dir) as ctx:
-        return job(ctx)
+    with build_run(cfg, run_dir) as built:
+        return job(built)

@@ -1,22 +1,30 @@
-"""The one place that calls hydra.utils.instantiate: composed config -> run context and job.
+"""The one place that calls hydra.utils.instantiate: composed config -> resources, session, runner, job.
 
-Shared resources (library, planner, backend, clock, speech) are built once here and travel in the
-RunContext; stages and planners receive plain typed arguments, never a DictConfig.
+Shared resources (library, planner, backend, clock, synthesizer, sequencer, control loop, ...) are built
+once here. A stage receives the ones it needs through its constructor: every constructor parameter
+whose name is a resource (`library`, `limits`, `synthesizer`, `sequencer`, `clock`, `loop`, `player`,
+`scene`, `safety`) is passed that resource, so adding a stage needs one YAML node and one class, and
+its dependencies are visible in its signature.
 """
 
 from __future__ import annotations
 
+import inspect
 from pathlib import Path
 from typing import Any
 
 from hydra.errors import InstantiationException
-from hydra.utils import instantiate
+from hydra.utils import get_class, instantiate
 from omegaconf import DictConfig, OmegaConf
 
 from emopose.clock import FakeClock, MonotonicClock
-from emopose.context import RunContext
-from emopose.library import MotionLibrary
+from emopose.control_loop import ControlLoop
 from emopose.pipeline import Pipeline
+from emopose.resources import Resources, Run
+from emopose.runner import TurnRunner
+from emopose.session import Session
+from emopose.speech.player import Player
+from emopose.tour.scene_view import SceneSlot
 from emopose.trajectory import TrajectoryBuilder
 
 
@@ -38,6 +46,32 @@ def make(node: Any, key: str, **kwargs: Any) -> Any:
     except (InstantiationException, TypeError, ValueError) as exc:  # a bad value the target rejected
         cause = exc.__cause__ or exc
         raise ConfigError(f"cannot build '{key}' ({OmegaConf.select(node, '_target_')}): {cause}") from exc
+
+
+def make_with(node: Any, key: str, resources: dict[str, Any]) -> Any:
+    """make() passing each resource the target's constructor asks for by name."""
+    if node is None or "_target_" not in node:
+        return None
+    try:
+        wanted = inspect.signature(get_class(node._target_)).parameters
+    except Exception as exc:  # an unknown or unimportable _target_
+        raise ConfigError(f"cannot build '{key}': {exc}") from exc
+    return make(node, key, **{name: value for name, value in resources.items() if name in wanted})
+
+
+def ordered_stages(pipeline: DictConfig) -> dict[str, Any]:
+    """The stage nodes in `pipeline.order`, with each `pipeline.insert_after` stage placed after its anchor."""
+    order = list(pipeline.order)
+    for name, anchor in (pipeline.get("insert_after") or {}).items():
+        if anchor not in order:
+            raise ConfigError(f"pipeline.insert_after.{name}: no stage {anchor!r} in the order {order}")
+        order.insert(order.index(anchor) + 1, name)
+    unplaced = [name for name in pipeline.stages if name not in order]
+    missing = [name for name in order if name not in pipeline.stages]
+    if unplaced or missing:
+        raise ConfigError(f"pipeline: stages {unplaced} have no place in the order (add them to "
+                          f"pipeline.insert_after) and {missing} in the order have no stage node")
+    return {name: pipeline.stages[name] for name in order}
 
 
 def safety_check(checker: Any):
@@ -63,23 +97,29 @@ def check_planner(planner: Any) -> None:
         raise ConfigError(f"planner: {exc}") from exc
 
 
-def build_context(cfg: DictConfig, run_dir: str | Path) -> RunContext:
-    library: MotionLibrary = make(cfg.library, "library")
+def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
+    library = make(cfg.library, "library")
     planner = make(cfg.planner, "planner", library=library)
     check_planner(planner)
-    stages = {name: make(node, f"pipeline.stages.{name}") for name, node in cfg.pipeline.stages.items()}
     backend = make(cfg.backend, "backend")
-    realtime = cfg.run.clock == "monotonic" or (cfg.run.clock == "auto" and getattr(backend, "realtime", False))
+    realtime = cfg.run.clock == "monotonic" or (cfg.run.clock == "auto" and backend.realtime)
     clock = MonotonicClock() if realtime else FakeClock()
-    builder = TrajectoryBuilder(library.limits)
-    sequencer = make(cfg.sequencer, "sequencer", builder=builder, neutral=library.neutral_entry.q[0],
-                     safety=safety_check(make(cfg.safety, "safety")))
-    speech = make(cfg.tts, "tts")
-    player = make(cfg.get("player"), "player")
-    thinking = make(cfg.get("thinking"), "thinking", library=library)
-    return RunContext(library=library, planner=planner, pipeline=Pipeline(stages), backend=backend,
-                      sequencer=sequencer, clock=clock, speech=speech, player=player, thinking=thinking,
-                      run_dir=Path(run_dir), record=bool(cfg.run.record))
+    safety = safety_check(make(cfg.safety, "safety"))
+    sequencer = make(cfg.sequencer, "sequencer", builder=TrajectoryBuilder(library.limits),
+                     neutral=library.neutral_entry.q[0], safety=safety)
+    loop = ControlLoop(sequencer, backend, clock)
+    player = make(cfg.get("player"), "player") or Player(sink="none")
+    shared = {"library": library, "limits": library.limits, "synthesizer": make(cfg.tts, "tts"),
+              "sequencer": sequencer, "clock": clock, "loop": loop, "player": player, "scene": SceneSlot(),
+              "safety": safety}
+    stages = {name: make_with(node, f"pipeline.stages.{name}", shared)
+              for name, node in ordered_stages(cfg.pipeline).items()}
+    resources = Resources(library=library, planner=planner, pipeline=Pipeline(stages), backend=backend,
+                          sequencer=sequencer, clock=clock, synthesizer=shared["synthesizer"], player=player,
+                          asr=make(cfg.get("asr"), "asr"), scene=shared["scene"], run_dir=Path(run_dir))
+    session = Session(backend, loop, library.neutral_entry.q[0], run_dir, record=bool(cfg.run.record))
+    thinking = make_with(cfg.get("thinking"), "thinking", shared)
+    return Run(resources, session, TurnRunner(planner, resources.pipeline, session, thinking))
 
 
 def build_job(cfg: DictConfig) -> Any:

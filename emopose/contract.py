@@ -16,7 +16,7 @@ from emopose import CLASSES, NUM_JOINTS
 GestureClass = Literal[
     "pointing", "emphasizing", "rejecting", "agreeing", "doubting", "welcoming", "comforting", "neutral"
 ]
-PlanSource = Literal["model", "plain_text", "keyword_fallback", "empty"]
+PlanSource = Literal["model", "plain_text", "keyword_fallback", "empty", "scripted"]  # scripted: no planner
 
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
 
@@ -49,6 +49,11 @@ class Plan(BaseModel):
     @property
     def top_class(self) -> str:
         return self.records[0].cls if self.records else "neutral"
+
+    @classmethod
+    def scripted(cls, reply: str, *records: GestureRecord) -> Plan:
+        """A plan written by code (a suite item, a robot check, a button), not by a planner."""
+        return cls(reply=reply, records=records, source="scripted")
 
 
 MotionType = Literal["sequence", "pose"]

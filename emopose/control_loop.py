@@ -3,13 +3,14 @@
 Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt) chains). With a
 FakeClock the same loop renders a run as fast as the CPU allows; with MonotonicClock it is real time.
 `run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background thread for
-the web UI, speech and the tour.
+the web UI, speech and the tour; `wait_until()` waits the right way for either.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -38,10 +39,9 @@ class LoopStats:
 
 
 class ControlLoop:
-    def __init__(self, sequencer: Sequencer, backend: Backend, clock: Clock,
-                 recorder: Recorder | None = None, dt: float = CONTROL_DT) -> None:
-        self.sequencer, self.backend, self.clock = sequencer, backend, clock
-        self.recorder, self.dt = recorder, dt
+    def __init__(self, sequencer: Sequencer, backend: Backend, clock: Clock, dt: float = CONTROL_DT) -> None:
+        self.sequencer, self.backend, self.clock, self.dt = sequencer, backend, clock, dt
+        self.recorder: Recorder | None = None
         self.stats = LoopStats()
         self._t0: float | None = None
         self._tick = 0
@@ -49,8 +49,9 @@ class ControlLoop:
         self._stop = threading.Event()
         self.error: BaseException | None = None
 
-    def begin(self, q0: np.ndarray) -> None:
-        """Start the stream at the measured pose q0."""
+    def begin(self, q0: np.ndarray, recorder: Recorder | None = None) -> None:
+        """Start the stream at the measured pose q0, recording every command to `recorder`."""
+        self.recorder = recorder
         self._t0 = self.clock.now()
         self._tick = 0
         self.sequencer.reset(q0, self._t0)
@@ -82,6 +83,19 @@ class ControlLoop:
             self.tick()
             if done():
                 return True
+        return False
+
+    def wait_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
+        """done() within timeout_s: polled (wall time) while the loop runs on its thread, else ticked here."""
+        if not self.running:
+            return self.run_until(done, timeout_s)
+        end = time.monotonic() + timeout_s
+        while time.monotonic() < end:
+            if done():
+                return True
+            if self.error is not None:
+                raise RuntimeError("control loop failed") from self.error
+            time.sleep(0.01)
         return False
 
     # -- background thread ---------------------------------------------------------------------

@@ -1,46 +1,35 @@
-"""Pipeline: the planner, then the six stages in order, each reading and writing named fields of a Turn.
+"""Pipeline: the stages in order, each reading and writing named fields of a Turn (emopose/turn.py).
 
-Stages declare `reads` (field names) and `writes` (one field name). The pipeline checks at build time,
-before any model call, that every read is written by an earlier stage (or is an input), so a
-mis-ordered or ablated pipeline is refused with a message naming the stage and the missing field.
+Stages declare `reads` and `writes` (Turn field names) and receive everything else they need in their
+constructors, so `__call__(turn)` takes the turn alone. The pipeline checks at build time, before any
+model call, that every read is written by an earlier stage (or is an input), so a mis-ordered or
+ablated pipeline is refused with a message naming the stage and the missing field. A run may enter
+later than the first stage (a scripted Plan enters at `resolve`). Hooks run after every stage with the
+stage and the turn (timing is the pipeline's own; the turn runner adds recording), and
 `step_through()` yields every intermediate value for the web UI, MCAP and tests.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any, Protocol, runtime_checkable
 
-from emopose.planners.base import PlannerOutput, PlanRequest
+from emopose.turn import Turn
 
-INPUTS = ("request", "planner_output")
+PLANNED = ("request", "planner_output")  # what the turn runner fills in before the first stage
 
 
 @runtime_checkable
 class Stage(Protocol):
     name: str
     reads: tuple[str, ...]
-    writes: str
+    writes: tuple[str, ...]
 
-    def __call__(self, turn: Turn, ctx: Any) -> Any: ...
+    def __call__(self, turn: Turn) -> Any: ...
 
 
-@dataclass
-class Turn:
-    """Everything one utterance produces on its way to joint commands."""
-
-    request: PlanRequest
-    planner_output: PlannerOutput | None = None
-    values: dict[str, Any] = field(default_factory=dict)
-    stage_s: dict[str, float] = field(default_factory=dict)
-
-    def __getattr__(self, name: str) -> Any:
-        values = self.__dict__.get("values", {})
-        if name in values:
-            return values[name]
-        raise AttributeError(f"turn has no field {name!r} (yet); fields so far: {sorted(values)}")
+Hook = Callable[[Stage, Turn], None]
 
 
 class PipelineError(ValueError):
@@ -48,42 +37,63 @@ class PipelineError(ValueError):
 
 
 class Pipeline:
-    def __init__(self, stages: Mapping[str, Stage] | list[Stage]) -> None:
+    def __init__(self, stages: Mapping[str, Stage] | Sequence[Stage], hooks: Sequence[Hook] = ()) -> None:
         items = list(stages.values()) if isinstance(stages, Mapping) else list(stages)
         self.stages: list[Stage] = [s for s in items if s is not None]
-        self._check_order()
+        self.hooks = tuple(hooks)
+        self._check_order(0, PLANNED)
 
-    def _check_order(self) -> None:
-        available = set(INPUTS)
-        for stage in self.stages:
+    def with_hooks(self, *hooks: Hook) -> Pipeline:
+        return Pipeline(self.stages, (*self.hooks, *hooks))
+
+    def _check_order(self, first: int, inputs: Sequence[str]) -> None:
+        known, available = set(Turn.field_names()), set(inputs)
+        for stage in self.stages[first:]:
             if not isinstance(stage, Stage):
                 raise PipelineError(f"{stage!r} is not a stage: it needs name, reads, writes and __call__")
+            unknown = [f for f in (*stage.reads, *stage.writes) if f not in known]
+            if unknown:
+                raise PipelineError(f"stage '{stage.name}' names {unknown}, which are not Turn fields {sorted(known)}")
             missing = [r for r in stage.reads if r not in available]
             if missing:
                 raise PipelineError(
                     f"stage '{stage.name}' reads {missing}, which no earlier stage writes; "
-                    f"order is {[s.name for s in self.stages]}, available before it: {sorted(available)}"
+                    f"order is {self.names}, available before it: {sorted(available)}"
                 )
-            available.add(stage.writes)
+            available.update(stage.writes)
 
     @property
     def names(self) -> list[str]:
         return [s.name for s in self.stages]
 
-    def step_through(self, turn: Turn, ctx: Any, planner: Any | None = None) -> Iterator[tuple[str, Any]]:
-        """Run the planner (unless turn already has its output) and each stage, yielding (name, value)."""
-        if turn.planner_output is None:
-            turn.planner_output = planner.plan(turn.request)
-            turn.stage_s["planner"] = turn.planner_output.latency_s
-            yield "planner_output", turn.planner_output
-        for stage in self.stages:
-            started = time.perf_counter()
-            value = stage(turn, ctx)
-            turn.stage_s[stage.name] = time.perf_counter() - started
-            turn.values[stage.writes] = value
-            yield stage.writes, value
+    def get(self, name: str) -> Stage | None:
+        """The stage called `name`, or None when this pipeline has none."""
+        return next((s for s in self.stages if s.name == name), None)
 
-    def run(self, turn: Turn, ctx: Any, planner: Any | None = None) -> Turn:
-        for _ in self.step_through(turn, ctx, planner):
+    def _first(self, turn: Turn, start: str | None) -> int:
+        if start is None:
+            return 0
+        if start not in self.names:
+            raise PipelineError(f"cannot start at '{start}': the pipeline is {self.names}")
+        first = self.names.index(start)
+        self._check_order(first, [f for f in Turn.field_names() if getattr(turn, f) is not None])
+        return first
+
+    def step_through(self, turn: Turn, start: str | None = None) -> Iterator[tuple[str, Any]]:
+        """Run each stage from `start` (default: the first), yielding (field, value) for what it writes."""
+        for stage in self.stages[self._first(turn, start):]:
+            began = time.perf_counter()
+            value = stage(turn)
+            turn.stage_s[stage.name] = time.perf_counter() - began
+            outputs = value if len(stage.writes) > 1 else (value,)
+            for name, output in zip(stage.writes, outputs, strict=True):
+                setattr(turn, name, output)
+            for hook in self.hooks:
+                hook(stage, turn)
+            for name, output in zip(stage.writes, outputs):
+                yield name, output
+
+    def run(self, turn: Turn, start: str | None = None) -> Turn:
+        for _ in self.step_through(turn, start):
             pass
         return turn

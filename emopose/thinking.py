@@ -1,6 +1,6 @@
 """Latency masking: a "thinking" library motion plays while the planner works (beyond the paper).
 
-RunContext.plan_turn wraps the planner call in `around_planning(ctx)`. On entry, if the sequencer is
+The turn runner wraps every planner call in `around_planning()`. On entry, if the sequencer is
 settled (a previous reply's gestures are never cut short for it), the motion is queued `repeats` times,
 released at once, so a slow model keeps the robot visibly thinking. When the plan arrives, whatever is
 left of it is interrupted through the sequencer's normal interruption path: pending repeats are
@@ -19,8 +19,9 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
+from emopose.clock import Clock
 from emopose.library import MotionLibrary
-from emopose.sequencer import GestureCommand
+from emopose.sequencer import GestureCommand, Sequencer
 
 log = logging.getLogger(__name__)
 
@@ -29,42 +30,44 @@ THINKING_LABEL = "thinking"
 
 @dataclass
 class ThinkingGesture:
+    library: MotionLibrary = field(repr=False)
+    sequencer: Sequencer = field(repr=False)
+    clock: Clock = field(repr=False)
     motion: str = "chin_stroke"
     repeats: int = 3
-    library: MotionLibrary | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         if self.repeats < 1:
             raise ValueError(f"thinking.repeats must be >= 1, got {self.repeats}")
-        if self.library is not None and self.library.get(self.motion) is None:
+        if self.library.get(self.motion) is None:
             doubting = [e.name for e in self.library.by_class("doubting")]
             raise ValueError(f"thinking.motion {self.motion!r} is not in the motion library; "
                              f"pick a loaded motion, e.g. one of {doubting or self.library.names[:8]}")
 
     @contextmanager
-    def around_planning(self, ctx) -> Iterator[None]:
-        ids = self.start(ctx)
+    def around_planning(self) -> Iterator[None]:
+        ids = self.start()
         try:
             yield
         finally:
-            self.stop(ctx, ids)
+            self.stop(ids)
 
-    def start(self, ctx) -> set[int]:
+    def start(self) -> set[int]:
         """Queue the thinking motion unless the sequencer is busy; returns the queued command ids."""
-        sequencer = ctx.sequencer
-        entry = ctx.library.get(self.motion)  # the live library: the motion may have been edited
+        sequencer = self.sequencer
+        entry = self.library.get(self.motion)  # the live library: the motion may have been edited
         if entry is None or not sequencer.settled():
             return set()
-        now = ctx.clock.now()
+        now = self.clock.now()
         commands = [GestureCommand(name=entry.name, keyframes=entry.q, duration=entry.default_duration,
                                    release_at=now, label=THINKING_LABEL) for _ in range(self.repeats)]
         for command in commands:
             sequencer.submit(command)
         return {c.id for c in commands}
 
-    def stop(self, ctx, ids: set[int]) -> None:
+    def stop(self, ids: set[int]) -> None:
         """The plan arrived: interrupt what is left of the thinking motion (nothing if it already ended)."""
-        sequencer = ctx.sequencer
+        sequencer = self.sequencer
         if not ids or sequencer.settled():
             return
         active = sequencer.active
@@ -72,4 +75,4 @@ class ThinkingGesture:
             return  # someone else's commands are running or queued; leave them to the sequencer
         running = active is not None or sequencer.state.value == "blending"
         log.info("plan arrived: %s the thinking motion %s", "interrupting" if running else "dropping", self.motion)
-        sequencer.interrupt([], now=ctx.clock.now())
+        sequencer.interrupt([], now=self.clock.now())

@@ -1,31 +1,40 @@
-"""What every backend offers the sequencer's 50 Hz loop.
+"""What every backend is: the sequencer's 50 Hz loop sends it one 14-DoF target per control tick.
 
-A backend receives one 14-DoF target per control tick, in the library's joint order
-(left arm 0-6, right arm 7-13, see library/g1/limits.yaml). Heavy imports (mujoco, cyclonedds)
-happen in connect(), never at module import, so dry-run and unit tests stay fast.
+Targets are in the library's joint order (emopose.robot.g1_spec.JOINT_NAMES: left arm 0-6,
+right arm 7-13). Heavy imports (mujoco, cyclonedds) happen in connect(), never at module import,
+so dry-run and unit tests stay fast. What only some backends can do (simulated state, rendering,
+a planar base) is declared by the small protocols in emopose.backends.capabilities, which callers
+check with isinstance.
 """
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from abc import ABC, abstractmethod
+from typing import ClassVar
 
 import numpy as np
 
 from emopose.recording import Recorder
 
 
-@runtime_checkable
-class Backend(Protocol):
-    name: str
+class Backend(ABC):
+    name: ClassVar[str]
+    # True: the loop must run on the wall clock (a real robot); False: virtual time is allowed.
+    realtime: ClassVar[bool] = False
 
-    def connect(self, recorder: Recorder | None) -> np.ndarray:
-        """Open the connection and return the measured 14-DoF pose to start the first trajectory from."""
+    @abstractmethod
+    def connect(self, recorder: Recorder | None) -> np.ndarray | None:
+        """Open the connection; return the measured 14-DoF pose to start from, or None when the
+        backend cannot measure (the run then starts from the library's neutral pose)."""
 
+    @abstractmethod
     def send(self, t: float, q: np.ndarray) -> None:
         """Command the (14,) target q at stream time t (seconds since the stream started)."""
 
+    @abstractmethod
     def measured(self) -> np.ndarray | None:
         """The latest measured (14,) joint positions, or None if the backend cannot measure."""
 
+    @abstractmethod
     def close(self) -> None:
         """Release the hardware or simulator; safe to call twice."""

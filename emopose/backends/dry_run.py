@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from emopose.backends.base import Backend
 from emopose.recording import Recorder
 
 
-class DryRunBackend:
+class DryRunBackend(Backend):
     name = "dry_run"
 
     def __init__(self, initial_pose: list[float] | None = None) -> None:

@@ -1,4 +1,4 @@
-"""MuJoCo backend: the project's G1 upper-body model under position servos, stepped at 50 Hz.
+"""MuJoCo backend: the physics of the project's G1 upper-body model under position servos, 50 Hz.
 
 Each send(t, q) is one control period: the 14 targets become the servos' setpoints and physics
 advances CONTROL_DT in `substeps` steps. Gravity is compensated through the actuators (the model's
@@ -9,6 +9,8 @@ stream's finite difference, as LowCmd_ hands q and dq to the G1's motor PD; with
 loop records the commanded stream, /joints/command, itself):
   /joints/sim      {"t", "q"}  the simulated pose at the end of that period, stamped t + CONTROL_DT
   /joints/torque   {"t", "tau", "ratio"}  joint torque (servo + gravcomp) and max |tau|/limit
+Attached parts, each built from its own config node: `renderer` (SimRenderer: on-demand images,
+live frames, video) and `planar_base` (MujocoPlanarBase: the tour's base, or None).
 """
 
 from __future__ import annotations
@@ -17,19 +19,23 @@ import logging
 import math
 import os
 import threading
-from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from emopose import CONTROL_DT, NUM_JOINTS
+from emopose.backends.base import Backend
+from emopose.backends.planar_base import MujocoPlanarBase
+from emopose.backends.sim_renderer import SimRenderer
 from emopose.recording import Recorder
-from emopose.robot.model import JOINT_NAMES, build_model
-from emopose.robot.render import FrameSink, OffscreenRenderer
+from emopose.robot.g1_spec import CONTROL_DT, JOINT_NAMES, NUM_JOINTS
+from emopose.robot.model import build_model
 
 log = logging.getLogger(__name__)
 
 
-class MujocoBackend:
+class MujocoBackend(Backend):
+    """Satisfies capabilities.SimulatedState and capabilities.Renderable."""
+
     name = "mujoco"
 
     def __init__(
@@ -40,14 +46,8 @@ class MujocoBackend:
         initial_pose: list[float] | None = None,
         velocity_feedforward: bool = True,
         max_feedforward_velocity: float = 4.0,
-        planar_base: bool = False,
-        render: bool = False,
-        render_every: int = 2,
-        width: int = 640,
-        height: int = 480,
-        camera: str = "front",
-        video_path: str | None = None,
-        frames_dir: str | None = None,
+        renderer: SimRenderer | None = None,
+        planar_base: MujocoPlanarBase | None = None,
         viewer: bool = False,
     ) -> None:
         if substeps is not None and timestep is not None:
@@ -63,33 +63,32 @@ class MujocoBackend:
         )
         self.velocity_feedforward = velocity_feedforward
         self.max_feedforward_velocity = max_feedforward_velocity
+        self.renderer = renderer or SimRenderer()  # on-demand frames only, unless configured
         self.planar_base = planar_base
-        self.render, self.render_every = render, max(1, int(render_every))
-        self.width, self.height, self.camera = width, height, camera
-        self.video_path, self.frames_dir = video_path, frames_dir
         self.viewer = viewer
         self.max_actuator_force_ratio = 0.0
-        # Refreshed every render_every ticks when render=True, so the web UI need not render.
-        self.last_frame: np.ndarray | None = None
         self.n_substeps: int | None = None
         self.model = self.data = None
         self._recorder: Recorder | None = None
         self._lock = threading.RLock()
-        self._renderer: OffscreenRenderer | None = None
-        self._sink: FrameSink | None = None
         self._viewer = None
         self._tick = 0
 
-    # -- Backend protocol -------------------------------------------------------------------
-    def connect(self, recorder: Recorder | None) -> np.ndarray:
+    def select_gl(self) -> bool:
+        """mujoco reads MUJOCO_GL at its first import: glfw for the viewer window, else egl."""
         want_viewer = self.viewer and bool(os.environ.get("DISPLAY"))
         if self.viewer and not want_viewer:
             log.warning("mujoco backend: viewer requested but no DISPLAY; running headless")
         os.environ.setdefault("MUJOCO_GL", "glfw" if want_viewer else "egl")
+        return want_viewer
+
+    # -- Backend ---------------------------------------------------------------------------------
+    def connect(self, recorder: Recorder | None) -> np.ndarray:
+        want_viewer = self.select_gl()
         import mujoco
 
         self._mj = mujoco
-        self.model = build_model(self.model_path, planar_base=self.planar_base)
+        self.model = build_model(self.model_path, planar_base=self.planar_base is not None)
         # A whole number of physics steps fills each control period (timestep rounded down to fit).
         dt = self.timestep if self.timestep is not None else self.model.opt.timestep
         self.n_substeps = self.substeps or max(1, math.ceil(CONTROL_DT / dt - 1e-9))
@@ -115,10 +114,9 @@ class MujocoBackend:
         mujoco.mj_forward(m, self.data)
         self._recorder, self._tick = recorder, 0
         self.max_actuator_force_ratio = 0.0
-        self.last_frame = None
-        if self.video_path or self.frames_dir:
-            fps = 1.0 / (CONTROL_DT * self.render_every)
-            self._sink = FrameSink(self.video_path, self.frames_dir, fps)
+        self.renderer.attach(m, self.data, self._lock)
+        if self.planar_base is not None:
+            self.planar_base.attach(m, self.data, self._lock)
         if want_viewer:
             import mujoco.viewer
 
@@ -156,10 +154,7 @@ class MujocoBackend:
             self._recorder.write(
                 "/joints/torque", t_sim, {"t": t_sim, "tau": tau.tolist(), "ratio": ratio}
             )
-        if (self.render or self._sink is not None) and self._tick % self.render_every == 0:
-            self.last_frame = self.render_frame()
-            if self._sink is not None:
-                self._sink.add(self.last_frame)
+        self.renderer.after_tick(self._tick)
         if self._viewer is not None and self._viewer.is_running():
             self._viewer.sync()
 
@@ -185,33 +180,14 @@ class MujocoBackend:
             return self.data.qpos[self._qadr].copy()
 
     def close(self) -> None:
-        if self._sink is not None:
-            self._sink.close()
-            self._sink = None
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        self.renderer.close()
         if self._viewer is not None:
             self._viewer.close()
             self._viewer = None
 
-    # -- Extras for the web UI, tests and the tour -------------------------------------------
-    def render_frame(self, camera: str | None = None) -> np.ndarray:
-        """One (height, width, 3) uint8 image of the current state (offscreen, EGL by default)."""
-        if self.data is None:
-            raise RuntimeError("mujoco backend: render_frame() before connect()")
-        if self._renderer is None:
-            self._renderer = OffscreenRenderer(self.model, self.width, self.height)
-        with self._lock:
-            return self._renderer.render(self.data, camera or self.camera)
-
-    def save_png(self, path: str | Path, camera: str | None = None) -> Path:
-        import imageio.v3 as iio
-
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        iio.imwrite(path, self.render_frame(camera))
-        return path
+    # -- SimulatedState, Renderable ---------------------------------------------------------------
+    def render_frame(self, camera: Any = None) -> np.ndarray:
+        return self.renderer.render_frame(camera)
 
     def contacts(self) -> list[tuple[str, str]]:
         """Geom-name pairs of current contacts between two robot geoms (the floor is not robot)."""
@@ -228,15 +204,3 @@ class MujocoBackend:
         """Current (14,) joint torques: servo plus gravity compensation, N m."""
         with self._lock:
             return self.data.qfrc_actuator[self._dadr].copy()
-
-    def set_base_velocity(self, vx: float, vy: float, yaw_rate: float) -> None:
-        """Planar-base model only: body-frame velocity command (m/s, m/s, rad/s), like the sport API."""
-        if not self.planar_base:
-            raise RuntimeError("mujoco backend: set_base_velocity needs planar_base=True")
-        m, d = self.model, self.data
-        with self._lock:
-            yaw = d.qpos[m.joint("base_yaw").qposadr[0]]
-            c, s = np.cos(yaw), np.sin(yaw)
-            d.ctrl[m.actuator("base_x").id] = c * vx - s * vy
-            d.ctrl[m.actuator("base_y").id] = s * vx + c * vy
-            d.ctrl[m.actuator("base_yaw").id] = yaw_rate

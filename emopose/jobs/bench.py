@@ -15,7 +15,7 @@ from emopose.bench.confusion import ABBREVIATIONS, ConfusionPanel, confusion_cou
 from emopose.bench.metrics import accuracy, by_pass, tier_accuracy
 from emopose.bench.suites import TIERS, load_bench
 from emopose.bench.tables import comparison_markdown, fmt
-from emopose.context import RunContext
+from emopose.resources import Resources, Run
 from emopose.jobs.report import write_results
 from emopose.jobs.suite_planning import plan_suite, resolve_passes, run_summary
 from emopose.planners.base import PlanRequest
@@ -30,14 +30,15 @@ class BenchJob:
     progress: bool = True
     confusion: bool = True
 
-    def __call__(self, ctx: RunContext) -> dict:
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
         unknown = sorted(set(self.tiers) - set(TIERS))
         if unknown:
             raise ValueError(f"job.tiers has unknown tiers {unknown}; allowed: {list(TIERS)}")
         items = load_bench(self.path, self.tiers)
         if not items:
             raise ValueError(f"{self.path} has no items of tiers {self.tiers} (bench.path)")
-        planner, passes = ctx.planner, resolve_passes(self.passes, ctx.planner)
+        planner, passes = res.planner, resolve_passes(self.passes, res.planner)
         requests = [PlanRequest(utterance=i.text) for i in items]
         predictions, planned_all = [], []
         started = time.perf_counter()
@@ -65,20 +66,20 @@ class BenchJob:
         }
         markdown = comparison_markdown([results]) + "\n" + leading_confusions(predictions, self.tiers)
         if self.confusion:
-            results["confusion_png"] = str(self.write_confusion(ctx, predictions, results))
+            results["confusion_png"] = str(self.write_confusion(res, predictions, results))
             markdown += f"\nConfusion matrices: {results['confusion_png']}\n"
-        write_results(ctx.run_dir, results, markdown)
+        write_results(res.run_dir, results, markdown)
         print(markdown)
         return results
 
-    def write_confusion(self, ctx: RunContext, predictions: list[dict], results: dict):
+    def write_confusion(self, res: Resources, predictions: list[dict], results: dict):
         panels = []
         for tier in [t for t in TIERS if t in self.tiers]:
             counts, failed = confusion_counts([(p["label"], p["pred"]) for p in predictions if p["tier"] == tier])
             title = f"{tier.capitalize()} ({counts.sum() + failed} decisions): {fmt(results['accuracy'][tier])}%"
             panels.append(ConfusionPanel(title, counts, failed))
         name = f"{results['method']}, {results['passes']} pass(es), pooled counts"
-        return plot_confusion(panels, ctx.run_dir / "confusion.png", suptitle=name)
+        return plot_confusion(panels, res.run_dir / "confusion.png", suptitle=name)
 
 
 def leading_confusions(predictions: list[dict], tiers: list[str], top: int = 5) -> str:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from emopose.bench.metrics import paired_context_accuracy
 from emopose.bench.suites import load_context
 from emopose.bench.tables import comparison_markdown
-from emopose.context import RunContext
+from emopose.resources import Run
 from emopose.jobs.report import write_results
 from emopose.jobs.suite_planning import plan_suite, resolve_passes, run_summary
 from emopose.planners.base import PlanRequest
@@ -26,11 +26,12 @@ class ContextAblationJob:
     chunk_size: int = 64
     progress: bool = True
 
-    def __call__(self, ctx: RunContext) -> dict:
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
         items = load_context(self.path)
         if not items:
             raise ValueError(f"{self.path} has no items (bench.path)")
-        planner, passes = ctx.planner, resolve_passes(self.passes, ctx.planner)
+        planner, passes = res.planner, resolve_passes(self.passes, res.planner)
         with_history = [PlanRequest(utterance=i.text, history=i.history) for i in items]
         without_history = [PlanRequest(utterance=i.text) for i in items]
         predictions, planned_all = [], []
@@ -61,6 +62,6 @@ class ContextAblationJob:
         markdown = comparison_markdown([results]) + (
             f"\nDiscordant pairs (pooled over passes): right only with history {d['only_with_history']}, "
             f"right only without {d['only_without_history']}.\n")
-        write_results(ctx.run_dir, results, markdown)
+        write_results(res.run_dir, results, markdown)
         print(markdown)
         return results

@@ -7,14 +7,13 @@ the weight down. The gesture goes through the normal resolve..dispatch stages at
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
 
-from emopose.context import RunContext
+from emopose.contract import GestureRecord, Plan
 from emopose.jobs.report import write_results
-from emopose.planners.base import PlannerOutput
+from emopose.resources import Run
 
 
 @dataclass
@@ -22,25 +21,23 @@ class G1CheckJob:
     gesture: str = "face_wave"
     intensity: int = 1
 
-    def __call__(self, ctx: RunContext) -> dict:
-        entry = ctx.library.get(self.gesture)
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        entry = res.library.get(self.gesture)
         if entry is None:
             raise ValueError(f"g1_check: no motion '{self.gesture}' in the library (job.gesture)")
-        ctx.open()
-        measured = ctx.backend.measured()
-        print(f"connected to {ctx.backend.name}; measured arm pose (rad): {np.round(measured, 3).tolist()}")
-        turn = ctx.new_turn(f"g1 check: {self.gesture}")
-        turn.planner_output = PlannerOutput(raw=json.dumps({
-            "reply": turn.request.utterance,
-            "gestures": [{"class": entry.cls, "variant": entry.name, "intensity": self.intensity}]}))
-        ctx.pipeline.run(turn, ctx)
+        loop = run.session.open()
+        measured = res.backend.measured()
+        print(f"connected to {res.backend.name}; measured arm pose (rad): {np.round(measured, 3).tolist()}")
+        record = GestureRecord(cls=entry.cls, variant=entry.name, intensity=self.intensity)
+        turn = run.runner.run_plan(Plan.scripted(f"g1 check: {self.gesture}", record))
         events = [(e.kind, e.name, round(e.t, 3)) for e in turn.dispatched.events if e.kind != "state"]
-        stats = ctx.loop.stats.summary()
-        results = {"backend": ctx.backend.name, "measured_start": np.asarray(measured).tolist(),
+        stats = loop.stats.summary()
+        results = {"backend": res.backend.name, "measured_start": np.asarray(measured).tolist(),
                    "gesture": self.gesture, "intensity": self.intensity, "completed": turn.dispatched.completed,
                    "events": events, "loop": stats}
-        write_results(ctx.run_dir, results, "\n".join([
-            f"# g1_check on {ctx.backend.name}", f"- start pose: {np.round(measured, 3).tolist()}",
+        write_results(res.run_dir, results, "\n".join([
+            f"# g1_check on {res.backend.name}", f"- start pose: {np.round(measured, 3).tolist()}",
             f"- gesture {self.gesture} at intensity {self.intensity}: "
             f"{'completed' if turn.dispatched.completed else 'NOT completed'}",
             f"- events: {events}", f"- 50 Hz loop: {stats}", "- release: blend to neutral, weight ramp to 0 (on exit)"]))

@@ -17,12 +17,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from emopose import CONTROL_DT
-from emopose.context import RunContext
+from emopose.backends.capabilities import Renderable, SimulatedState
 from emopose.jobs.contact_sheet import render_keyframes, render_pose, write_overview, write_sheet
 from emopose.jobs.report import markdown_table, write_results
 from emopose.jobs.tracking import StreamTap, tracking_error
+from emopose.resources import Resources, Run
 from emopose.robot.collision import SelfCollisionChecker
-from emopose.stages.modulate import INTENSITY_GAINS, LIMIT_MARGIN, modulate_keyframes
+from emopose.stages.modulate import Modulate
 
 log = logging.getLogger(__name__)
 
@@ -40,23 +41,24 @@ class LibraryCheckJob:
         if bad or not self.intensities:
             raise ValueError(f"library_check: intensities must be a non-empty subset of 1..5, got {self.intensities}")
 
-    def __call__(self, ctx: RunContext) -> dict:
-        backend = ctx.backend
-        if not all(hasattr(backend, a) for a in ("reset", "contacts", "render_frame")):
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        backend = res.backend
+        if not (isinstance(backend, SimulatedState) and isinstance(backend, Renderable)):
             raise ValueError(f"library_check needs backend=mujoco (got backend {backend.name!r})")
-        names = self.motions or ctx.library.names
-        unknown = [n for n in names if ctx.library.get(n) is None]
+        names = self.motions or res.library.names
+        unknown = [n for n in names if res.library.get(n) is None]
         if unknown:
-            raise ValueError(f"library_check: unknown motions {unknown}; the library has {ctx.library.names}")
+            raise ValueError(f"library_check: unknown motions {unknown}; the library has {res.library.names}")
         backend.connect(None)
-        modulate = next((s for s in ctx.pipeline.stages if s.name == "modulate"), None)
-        gains, margin = (modulate.gains, modulate.margin) if modulate else (INTENSITY_GAINS, LIMIT_MARGIN)
+        # The configured intensity law (or the paper's, when the pipeline ablates modulate).
+        modulate = res.pipeline.get("modulate") or Modulate(res.library.limits)
         report, images = {}, {}
         for name in names:
-            entry = ctx.library.get(name)
+            entry = res.library.get(name)
             levels = self.intensities if entry.motion_type == "sequence" else [3]
-            runs = {level: self._run(ctx, modulate_keyframes(entry.q, level, ctx.library.limits, gains, margin),
-                                     entry.default_duration) for level in levels}
+            runs = {level: self._run(res, modulate.keyframes(entry.q, level), entry.default_duration)
+                    for level in levels}
             report[name] = self._motion_summary(entry, runs)
             if self.sheets:
                 images[name] = render_keyframes(backend, entry.q, self.cameras)
@@ -65,22 +67,22 @@ class LibraryCheckJob:
                 if contact is not None:
                     level, t, pair, q = contact
                     extra = (render_pose(backend, q, self.cameras), f"contact L{level} t={t:.2f}s\n{pair}")
-                report[name]["sheet"] = str(write_sheet(ctx.run_dir / "sheets", entry, images[name], extra,
+                report[name]["sheet"] = str(write_sheet(res.run_dir / "sheets", entry, images[name], extra,
                                                         self._status(report[name])))
             log.info("%s: %s", name, self._status(report[name]))
         if self.sheets:
-            write_overview(ctx.run_dir / "sheets" / "overview.png", ctx.library, images,
+            write_overview(res.run_dir / "sheets" / "overview.png", res.library, images,
                            {n: self._status(r) for n, r in report.items()})
         results = self._results(report)
-        write_results(ctx.run_dir, results, self._markdown(results))
+        write_results(res.run_dir, results, self._markdown(results))
         print(self._markdown(results).split("\n\n")[1])
         return results
 
     # -- one (motion, level) run ---------------------------------------------------------------
-    def _run(self, ctx: RunContext, keyframes: np.ndarray, duration: float) -> dict:
-        backend, limits = ctx.backend, ctx.library.limits
-        neutral = ctx.library.neutral_entry.q[0]
-        trajectory = ctx.sequencer.builder.build(keyframes, duration, neutral)
+    def _run(self, res: Resources, keyframes: np.ndarray, duration: float) -> dict:
+        backend, limits = res.backend, res.library.limits
+        neutral = res.library.neutral_entry.q[0]
+        trajectory = res.sequencer.builder.build(keyframes, duration, neutral)
         samples = trajectory.samples
         tap = StreamTap(backend)
         backend.reset(samples[0])
@@ -93,7 +95,7 @@ class LibraryCheckJob:
             c = contacts.setdefault(f"{pair[0]}|{pair[1]}", {"first_t": t, "last_t": t, "ticks": 0, "tick": tick})
             c["last_t"], c["ticks"] = t, c["ticks"] + 1
         first_contact = min(contacts.values(), key=lambda c: c["first_t"], default=None)
-        reason = ctx.sequencer.safety(samples) if ctx.sequencer.safety else None
+        reason = res.sequencer.safety(samples) if res.sequencer.safety else None
         return {
             "contacts": {p: {k: v for k, v in c.items() if k != "tick"} for p, c in contacts.items()},
             "_contact_state": None if first_contact is None else states[first_contact["tick"]],

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from emopose.context import RunContext
+from emopose.resources import Run
 from emopose.jobs.report import markdown_table, write_results
 
 
@@ -13,10 +13,12 @@ class PlanJob:
     utterance: str
     image: str | None = None
 
-    def __call__(self, ctx: RunContext) -> dict:
+    def __call__(self, run: Run) -> dict:
         if not self.utterance.strip():
             raise ValueError("utterance is empty: pass utterance=\"...\"")
-        turn = ctx.run_turn(self.utterance, self.image)
+        res = run.resources
+        turn = run.runner.run(self.utterance, self.image)
+        recorder = run.session.recorder
         rows = []
         for resolved, release in zip(turn.resolved, turn.schedule.releases):
             r = resolved.record
@@ -26,22 +28,16 @@ class PlanJob:
         started = [e for e in turn.dispatched.events if e.kind == "started"]
         results = {
             "utterance": self.utterance,
-            "planner": ctx.planner.name,
-            "reply": turn.plan.reply,
-            "plan_source": turn.plan.source,
-            "records": [r.as_json() for r in turn.plan.records],
-            "resolved": [r.audit() for r in turn.resolved],
-            "releases_s": [r.release_s for r in turn.schedule.releases],
-            "speech_duration_s": turn.schedule.speech.duration_s,
+            "planner": res.planner.name,
+            "turn": turn.to_json(),
             "executed": [{"name": e.name, "t": e.t} for e in started],
             "completed": turn.dispatched.completed,
-            "mcap": str(ctx.recorder.path) if ctx.recorder else None,
-            "stage_ms": {k: v * 1e3 for k, v in turn.stage_s.items()},
+            "mcap": str(recorder.path) if recorder else None,
         }
         text = (f"Utterance: {self.utterance}\nReply: {turn.plan.reply}  (plan from {turn.plan.source}, "
-                f"planner {ctx.planner.name})\n\n{table}\n\nSpeech {turn.schedule.speech.duration_s:.2f} s; "
-                f"{len(started)} gesture(s) executed on {ctx.backend.name}; "
+                f"planner {res.planner.name})\n\n{table}\n\nSpeech {turn.speech.duration_s:.2f} s; "
+                f"{len(started)} gesture(s) executed on {res.backend.name}; "
                 f"recording: {results['mcap']}")
-        write_results(ctx.run_dir, results, text)
+        write_results(res.run_dir, results, text)
         print(text)
         return results

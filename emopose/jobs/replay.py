@@ -14,11 +14,12 @@ from pathlib import Path
 import numpy as np
 
 from emopose import CONTROL_DT, NUM_JOINTS
-from emopose.context import RunContext
+from emopose.backends.capabilities import SimulatedState
 from emopose.jobs.contact_sheet import view
 from emopose.jobs.report import write_results
 from emopose.jobs.tracking import StreamTap, tracking_error
 from emopose.recording import Recorder, read_recording
+from emopose.resources import Run
 
 
 def command_grid(rows: list[tuple[float, dict]], dt: float = CONTROL_DT) -> tuple[np.ndarray, np.ndarray]:
@@ -52,7 +53,8 @@ class ReplayJob:
         if self.render_every < 1:
             raise ValueError(f"replay: render_every must be >= 1, got {self.render_every}")
 
-    def __call__(self, ctx: RunContext) -> dict:
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
         streams = read_recording(self.mcap)
         if not streams.get(self.topic):
             raise ValueError(f"replay: {self.mcap} has no messages on {self.topic}; topics: {sorted(streams)}")
@@ -60,14 +62,14 @@ class ReplayJob:
         if self.max_seconds is not None:
             keep = times - times[0] <= self.max_seconds + 1e-9
             times, commands = times[keep], commands[keep]
-        backend = ctx.backend
-        if not hasattr(backend, "reset"):
+        backend = res.backend
+        if not isinstance(backend, SimulatedState):
             raise ValueError(f"replay needs backend=mujoco (got backend {backend.name!r})")
-        if ctx.record:
-            ctx.recorder = Recorder(ctx.run_dir / "replay.mcap")  # closed by ctx.close()
-        backend.connect(ctx.recorder)
+        # The replay's own recording (the simulated response), not the session's: no control loop runs here.
+        recorder = Recorder(res.run_dir / "replay.mcap") if run.session.record else None
+        backend.connect(recorder)
         backend.reset(commands[0])
-        sink, video = self._sink(ctx)
+        sink, video = self._sink(res.run_dir)
         tap = StreamTap(backend)
         camera = view(self.camera)  # front/oblique/side: upper-body presets; else an MJCF camera
         try:
@@ -78,6 +80,8 @@ class ReplayJob:
         finally:
             if sink is not None:
                 sink.close()
+            if recorder is not None:
+                recorder.close()
         error = tracking_error(np.array(tap.commands), np.array(tap.states), points=100)
         raw = np.abs(np.array(tap.states) - np.array(tap.commands))
         results = {
@@ -85,7 +89,7 @@ class ReplayJob:
             "recorded_messages": len(streams[self.topic]), "duration_s": float(times[-1] - times[0]),
             "mae_rad": float(raw.mean()), "mae_resampled_rad": error.mae,
             "mae_time_aligned_rad": error.mae_time_aligned, "max_abs_error_rad": error.max_abs,
-            "max_actuator_force_ratio": float(getattr(backend, "max_actuator_force_ratio", float("nan"))),
+            "max_actuator_force_ratio": float(backend.max_actuator_force_ratio),
             "self_contacts": sorted({f"{p[0]}|{p[1]}" for _, _, p in tap.contacts}),
             "video": str(video) if video else None,
         }
@@ -96,14 +100,14 @@ class ReplayJob:
                 f"peak {results['max_abs_error_rad']:.4f} rad. Max actuator-force ratio "
                 f"{results['max_actuator_force_ratio']:.3f}. Self-contacts: {results['self_contacts'] or 'none'}."
                 f"\n\nVideo: {results['video'] or 'not rendered'}")
-        write_results(ctx.run_dir, results, text)
+        write_results(res.run_dir, results, text)
         print(text)
         return results
 
-    def _sink(self, ctx: RunContext):
+    def _sink(self, run_dir: Path):
         if not self.video:
             return None, None
         from emopose.robot.render import FrameSink
 
-        path = ctx.run_dir / self.video
+        path = run_dir / self.video
         return FrameSink(str(path), None, fps=1.0 / (CONTROL_DT * self.render_every)), path

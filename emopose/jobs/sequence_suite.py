@@ -15,7 +15,7 @@ from emopose.bench.metrics import aggregate_passes
 from emopose.bench.sequence_metrics import SequencePrediction, suite_scores
 from emopose.bench.suites import load_sequence
 from emopose.bench.tables import comparison_markdown
-from emopose.context import RunContext
+from emopose.resources import Run
 from emopose.jobs.report import write_results
 from emopose.jobs.suite_planning import PlannedItem, plan_suite, resolve_passes, run_summary
 from emopose.planners.base import PlanRequest
@@ -39,13 +39,14 @@ class SequenceSuiteJob:
     chunk_size: int = 64
     progress: bool = True
 
-    def __call__(self, ctx: RunContext) -> dict:
-        entries = ctx.library.snapshot.entries
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        entries = res.library.snapshot.entries
         variant_classes = {name: e.cls for name, e in entries.items()} if self.check_variants else None
         items = load_sequence(self.path, variant_classes)
         if not items:
             raise ValueError(f"{self.path} has no items (bench.path)")
-        planner, passes = ctx.planner, resolve_passes(self.passes, ctx.planner)
+        planner, passes = res.planner, resolve_passes(self.passes, res.planner)
         requests = [PlanRequest(utterance=i.text) for i in items]
         per_pass, predictions, planned_all = [], [], []
         started = time.perf_counter()
@@ -77,6 +78,6 @@ class SequenceSuiteJob:
         markdown = comparison_markdown([results]) + (
             f"\nPooled over {passes} pass(es) x {len(items)} plans: {seg['over_total']} over-segmented, "
             f"{seg['under_total']} under-segmented, {seg['failed_total']} failed.\n")
-        write_results(ctx.run_dir, results, markdown)
+        write_results(res.run_dir, results, markdown)
         print(markdown)
         return results

@@ -2,7 +2,7 @@
 
 The control loop runs on its own thread in real time for as long as the server runs; turns are
 planned on a worker thread. uvicorn owns the main thread until Ctrl-C, then everything is released
-(RunContext.close stops the loop and the backend). Settings are validated when the job is built, so
+(the session's close() stops the loop and the backend). Settings are validated when the job is built, so
 a bad serve.* value (say, a network bind without a token) stops before anything starts.
 """
 
@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 from emopose.build import ConfigError
 from emopose.clock import MonotonicClock
-from emopose.context import RunContext
 from emopose.jobs.report import write_results
+from emopose.resources import Run
 from emopose.web.settings import ServeSettings
 
 log = logging.getLogger(__name__)
@@ -28,18 +28,19 @@ class ServeJob:
     def __post_init__(self) -> None:
         self.settings = ServeSettings.model_validate(self.serve)
 
-    def __call__(self, ctx: RunContext) -> dict:
-        if not isinstance(ctx.clock, MonotonicClock):
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        if not isinstance(res.clock, MonotonicClock):
             raise ConfigError("serve needs real time: run with run.clock=monotonic (the serve experiment sets it)")
         import uvicorn  # the web extras load only when serving
 
         from emopose.web.app import create_app
         from emopose.web.live import open_session
 
-        session = open_session(ctx, self.settings, render=self.render)  # renderer first: its setup holds the GIL
+        session = open_session(run, self.settings, render=self.render)  # renderer first: its setup holds the GIL
+        loop = run.session.open()
         try:
-            ctx.open()
-            ctx.loop.start()
+            loop.start()
             app = create_app(session)
             s = self.settings
             print(f"EmoPose UI: http://{s.host}:{s.port}/  (Pose Studio: /studio)"
@@ -48,10 +49,10 @@ class ServeJob:
                         log_level="warning", access_log=False)
         finally:
             session.close()
-            ctx.loop.stop()
+            loop.stop()
         turns = [m for m in session.log_since(0) if m["type"] == "turn"]
-        results = {"turns": len(turns), "backend": ctx.backend.name, "planner": ctx.planner.name,
-                   "library_version": ctx.library.version, "loop": ctx.loop.stats.summary()}
-        write_results(ctx.run_dir, results, f"Served {len(turns)} turn(s) on {ctx.backend.name} with "
-                                            f"planner {ctx.planner.name}; control loop {results['loop']}")
+        results = {"turns": len(turns), "backend": res.backend.name, "planner": res.planner.name,
+                   "library_version": res.library.version, "loop": loop.stats.summary()}
+        write_results(res.run_dir, results, f"Served {len(turns)} turn(s) on {res.backend.name} with "
+                                            f"planner {res.planner.name}; control loop {results['loop']}")
         return results

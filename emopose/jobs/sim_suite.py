@@ -19,11 +19,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from emopose import CLASSES
-from emopose.context import RunContext
+from emopose.backends.capabilities import SimulatedState
+from emopose.contract import GestureRecord, Plan
 from emopose.jobs.report import write_results
 from emopose.jobs.sim_report import suite_markdown
 from emopose.jobs.tracking import StreamTap, latency_ms, sim_mae, tracking_error
-from emopose.planners.base import PlannerOutput
+from emopose.resources import Run
 from emopose.sequencer import State
 
 log = logging.getLogger(__name__)
@@ -48,21 +49,22 @@ class SimSuiteJob:
         if not 1 <= self.intensity <= 5:
             raise ValueError(f"sim_suite: intensity must be 1..5, got {self.intensity}")
 
-    def __call__(self, ctx: RunContext) -> dict:
-        motions = {c: ctx.library.class_default(c) for c in CLASSES}
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        motions = {c: res.library.class_default(c) for c in CLASSES}
         missing = [c for c, m in motions.items() if m is None]
         if missing:
             raise ValueError(f"sim_suite: library has no motion for classes {missing}")
         order = np.random.default_rng(self.seed).permutation(
             np.repeat(np.array(CLASSES), self.trials // len(CLASSES)))
-        loop = ctx.open()
+        loop = run.session.open()
         tap = StreamTap(loop.backend)
         loop.backend = tap  # capture command/state pairs in memory, tick by tick
-        t0 = ctx.clock.now() - loop.stream_time
-        rows = [self._trial(ctx, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
-        results = self._summarise(ctx, rows)
-        write_results(ctx.run_dir, results, suite_markdown(results))
-        (ctx.run_dir / "trials.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+        t0 = res.clock.now() - loop.stream_time
+        rows = [self._trial(run, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
+        results = self._summarise(run, rows)
+        write_results(res.run_dir, results, suite_markdown(results))
+        (res.run_dir / "trials.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
         print(suite_markdown(results).split("\n\n")[1])
         return results
 
@@ -71,21 +73,18 @@ class SimSuiteJob:
             return "rest" if k % 2 else "previous"
         return self.start_from
 
-    def _trial(self, ctx: RunContext, tap: StreamTap, t0: float, k: int, cls: str, motion: str) -> dict:
-        loop, sequencer = ctx.loop, ctx.sequencer
+    def _trial(self, run: Run, tap: StreamTap, t0: float, k: int, cls: str, motion: str) -> dict:
+        loop, sequencer = run.session.loop, run.resources.sequencer
         start = self._start_mode(k)
         if start == "rest":
             loop.run_until(lambda: sequencer.state == State.IDLE, self.rest_timeout_s)
         q_start = sequencer.last.copy()
         first_tick, first_build = len(tap), len(sequencer.construction_s)
-        backend = tap.backend
-        if hasattr(backend, "max_actuator_force_ratio"):
-            backend.max_actuator_force_ratio = 0.0  # per-trial peak
-        turn = ctx.new_turn(f"sim trial {k}: {cls}", use_history=False)
-        turn.planner_output = PlannerOutput(raw=json.dumps({"reply": f"Trial {k}.", "gestures": [
-            {"class": cls, "variant": motion, "intensity": self.intensity}]}))
-        ctx.pipeline.run(turn, ctx)
-        ctx.record_turn(turn)
+        simulated = tap.backend if isinstance(tap.backend, SimulatedState) else None
+        if simulated is not None:
+            simulated.max_actuator_force_ratio = 0.0  # per-trial peak
+        record = GestureRecord(cls=cls, variant=motion, intensity=self.intensity)
+        turn = run.runner.run_plan(Plan.scripted(f"Trial {k}.", record), utterance=f"sim trial {k}: {cls}")
         report, command = turn.dispatched, turn.submitted.commands[0]
         mine = [e for e in report.events if e.command_id == command.id]
         kinds = {e.kind for e in mine}
@@ -95,7 +94,7 @@ class SimSuiteJob:
                "stopped": "stopped" in kinds, "rejected": "rejected" in kinds, "timeout": not report.completed,
                "construction_s": sequencer.construction_s[first_build:],
                "submission_s": list(turn.submitted.submission_s)}
-        row["force_ratio"] = float(getattr(backend, "max_actuator_force_ratio", float("nan")))
+        row["force_ratio"] = simulated.max_actuator_force_ratio if simulated is not None else float("nan")
         started = next((e for e in mine if e.kind == "started"), None)
         done = next((e for e in mine if e.kind == "completed"), None)
         if started is None or done is None:
@@ -110,7 +109,8 @@ class SimSuiteJob:
         row["_error"] = error
         return row
 
-    def _summarise(self, ctx: RunContext, rows: list[dict]) -> dict:
+    def _summarise(self, run: Run, rows: list[dict]) -> dict:
+        res, recorder = run.resources, run.session.recorder
         errors = [r.pop("_error") for r in rows if "_error" in r]
         done = [r for r in rows if "mae_rad" in r]
         per_class, per_class_time, per_class_force = {}, {}, {}
@@ -141,14 +141,13 @@ class SimSuiteJob:
             "submission_ms": latency_ms([s for r in rows for s in r["submission_s"]]),
             "start_offset_rad": {m: float(np.mean([r["start_offset_rad"] for r in rows if r["start"] == m] or [0]))
                                  for m in ("previous", "rest")},
-            "motions": {c: ctx.library.class_default(c).name for c in CLASSES},
+            "motions": {c: res.library.class_default(c).name for c in CLASSES},
             "intensity": self.intensity,
             "start_from": self.start_from,
             "points": self.points,
-            "backend": ctx.backend.name,
-            "dispatch_until": getattr(next((s for s in ctx.pipeline.stages if s.name == "dispatch"), None),
-                                      "until", None),
+            "backend": res.backend.name,
+            "dispatch_until": res.pipeline.get("dispatch").until,
             "alignment": "tick: command n vs simulated pose after tick n's physics (stamped t_n + 0.02 s); "
                          "time: that pose vs command n+1 issued at t_n + 0.02 s",
-            "mcap": str(ctx.recorder.path) if ctx.recorder else None,
+            "mcap": str(recorder.path) if recorder else None,
         }

@@ -14,16 +14,16 @@ every released gesture is compared with the onset espeak reports for its trigger
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from emopose.clock import FakeClock
-from emopose.context import RunContext
 from emopose.jobs.report import markdown_table, write_results
 from emopose.jobs.sync_measure import GestureSync, SuiteItem, load_suite, measure_turn, summarize
-from emopose.stages.dispatch import Dispatch
-from emopose.stages.schedule import ScheduleStage
-from emopose.stages.sequence import SequenceStage
+from emopose.pipeline import Pipeline
+from emopose.resources import Resources, Run
+from emopose.runner import TurnRunner
+from emopose.speech.espeak import EspeakSynthesizer
 
 log = logging.getLogger(__name__)
 
@@ -36,20 +36,21 @@ class SyncEvalJob:
     limit: int | None = None
     target_p95_ms: float = 60.0  # words mode, scheduled vs onset
 
-    def __call__(self, ctx: RunContext) -> dict:
-        if not hasattr(ctx.speech, "word_events"):
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        if not isinstance(res.synthesizer, EspeakSynthesizer):
             raise ValueError(f"sync_eval measures against the engine's own word events, but tts is "
-                             f"{getattr(ctx.speech, 'name', ctx.speech)!r}: run it with tts=espeak")
-        if not isinstance(ctx.clock, FakeClock):
+                             f"{res.synthesizer.name!r}: run it with tts=espeak")
+        if not isinstance(res.clock, FakeClock):
             raise ValueError("sync_eval runs on virtual time: use backend=dry_run with run.clock=auto")
         suite_path, items = self._items()
-        ctx.open()
+        run.session.open()
         rows: dict[str, list[GestureSync]] = {}
         for mode in self.modes:
-            stages = self._stages(ctx, mode)
-            rows[mode] = [row for item in items for row in self._run_item(ctx, stages, item)]
-        results = self._results(ctx, suite_path, items, rows)
-        write_results(ctx.run_dir, results, self._markdown(results))
+            runner = run.runner.with_pipeline(self._pipeline(res.pipeline, mode))
+            rows[mode] = [row for item in items for row in self._run_item(res, runner, item)]
+        results = self._results(run, suite_path, items, rows)
+        write_results(res.run_dir, results, self._markdown(results))
         print(self._markdown(results))
         return results
 
@@ -62,37 +63,35 @@ class SyncEvalJob:
             path = Path(self.fallback_suite)
         return path, load_suite(path, self.limit)
 
-    def _stages(self, ctx: RunContext, mode: str) -> list:
-        configured = {s.name: s for s in ctx.pipeline.stages}
-        missing = [n for n in ("resolve", "modulate", "dispatch") if n not in configured]
+    @staticmethod
+    def _pipeline(configured: Pipeline, mode: str) -> Pipeline:
+        """The configured stages from resolve on, scheduled in `mode`, queueing (no interrupt), and
+        dispatched until rest, so each item starts from rest with an empty queue."""
+        stages = {n: configured.get(n) for n in ("resolve", "modulate", "schedule", "sequence", "dispatch")}
+        missing = [n for n, stage in stages.items() if stage is None]
         if missing:
-            raise ValueError(f"sync_eval needs pipeline stages {missing}; pipeline has {list(configured)}")
-        # Each item must start from rest with an empty queue, so dispatch waits for the neutral recovery.
-        dispatch = Dispatch(timeout_s=configured["dispatch"].timeout_s, until="rest")
-        return [configured["resolve"], configured["modulate"], ScheduleStage(mode=mode),
-                SequenceStage(interrupt=False), dispatch]
+            raise ValueError(f"sync_eval needs pipeline stages {missing}; pipeline has {configured.names}")
+        return Pipeline([stages["resolve"], stages["modulate"], replace(stages["schedule"], mode=mode),
+                         replace(stages["sequence"], interrupt=False), replace(stages["dispatch"], until="rest")])
 
-    def _run_item(self, ctx: RunContext, stages: list, item: SuiteItem) -> list[GestureSync]:
-        turn = ctx.new_turn(item.text, use_history=False)
-        turn.values["plan"] = item.plan()
-        for stage in stages:
-            turn.values[stage.writes] = stage(turn, ctx)
+    def _run_item(self, res: Resources, runner: TurnRunner, item: SuiteItem) -> list[GestureSync]:
+        turn = runner.run_plan(item.plan(), utterance=item.text)
         if not turn.dispatched.completed:
             log.warning("item %s did not come to rest within the dispatch timeout", item.id)
-        return measure_turn(item, turn, ctx.speech.word_events(item.text))
+        return measure_turn(item, turn, res.synthesizer.word_events(item.text))
 
-    def _results(self, ctx: RunContext, suite_path: Path, items: list[SuiteItem], rows: dict) -> dict:
+    def _results(self, run: Run, suite_path: Path, items: list[SuiteItem], rows: dict) -> dict:
         summaries = {mode: summarize(r) for mode, r in rows.items()}
         missing = [{"item": r.item, "k": r.k, "trigger": r.trigger}
                    for r in next(iter(rows.values()), []) if not r.found]
         for m in missing:
             log.warning("say-do check: item %s record %d trigger %r is not in the reply", m["item"], m["k"], m["trigger"])
         words_p95 = summaries.get("words", {}).get("scheduled_vs_onset", {}).get("p95_abs_ms")
-        speech = ctx.speech
+        speech = run.resources.synthesizer
         return {
             "suite": str(suite_path), "items": len(items),
-            "tts": {"engine": speech.name, "voice": getattr(speech, "voice", None), "rate": getattr(speech, "rate", None)},
-            "control_dt_s": ctx.loop.dt, "modes": summaries,
+            "tts": {"engine": speech.name, "voice": speech.voice, "rate": speech.rate},
+            "control_dt_s": run.session.loop.dt, "modes": summaries,
             "target": {"words_p95_scheduled_vs_onset_ms": self.target_p95_ms, "value_ms": words_p95,
                        "met": words_p95 is not None and words_p95 <= self.target_p95_ms},
             "say_do": {"missing": len(missing), "records": missing},

@@ -35,7 +35,7 @@ class SuiteItem:
         """The annotation as the planner's answer: the reply is the text, one record per label."""
         records = tuple(GestureRecord(cls=c, variant=v, trigger=a) for c, a, v in
                         zip(self.labels, self.anchors, self.variants))
-        return Plan(reply=self.text, records=records, source="model", notes=("sync_eval annotation",))
+        return Plan(reply=self.text, records=records, source="scripted", notes=("sync_eval annotation",))
 
 
 def load_suite(path: Path, limit: int | None = None) -> list[SuiteItem]:
@@ -111,7 +111,7 @@ def measure_turn(item: SuiteItem, turn, events) -> list[GestureSync]:
         span, trigger = spans[k], item.anchors[k]
         onset = onset_of_span(item.text, events, *span) if span else None
         after = [t for i, t in kept.items() if span and i >= span[1]]
-        center = (onset + min(after, default=schedule.speech.duration_s)) / 2 if onset is not None else None
+        center = (onset + min(after, default=turn.speech.duration_s)) / 2 if onset is not None else None
         actual = started[command.id] - submitted.speech_start if command.id in started else None
         queued = actual is not None and actual - release.release_s > CONTROL_DT + 1e-9
         first = span is not None and trigger_position(item.text, trigger) == span[0]

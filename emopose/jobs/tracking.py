@@ -18,14 +18,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from emopose import CONTROL_DT
+from emopose.backends.base import Backend
+from emopose.backends.capabilities import SimulatedState
+from emopose.recording import Recorder
 
 
-class StreamTap:
-    """Wraps a backend: forwards every call, and per send() keeps the command, the simulated pose
+class StreamTap(Backend):
+    """Wraps a backend: forwards the Backend calls, and per send() keeps the command, the simulated pose
     after that tick's physics and any robot self-contacts (geom pairs) seen at that moment."""
 
-    def __init__(self, backend: object) -> None:
+    def __init__(self, backend: Backend) -> None:
         self.backend = backend
+        self.realtime = backend.realtime
+        self._simulated = backend if isinstance(backend, SimulatedState) else None
         self.times: list[float] = []
         self.commands: list[np.ndarray] = []
         self.states: list[np.ndarray] = []
@@ -35,10 +40,14 @@ class StreamTap:
     def name(self) -> str:
         return self.backend.name
 
-    def __getattr__(self, attr: str):  # connect, measured, close, render_frame, ... pass through
-        if attr == "backend":
-            raise AttributeError(attr)
-        return getattr(self.backend, attr)
+    def connect(self, recorder: Recorder | None) -> np.ndarray | None:
+        return self.backend.connect(recorder)
+
+    def measured(self) -> np.ndarray | None:
+        return self.backend.measured()
+
+    def close(self) -> None:
+        self.backend.close()
 
     def send(self, t: float, q: np.ndarray) -> None:
         self.backend.send(t, q)
@@ -47,9 +56,9 @@ class StreamTap:
         self.commands.append(np.array(q, dtype=float))
         measured = self.backend.measured()
         self.states.append(np.array(q if measured is None else measured, dtype=float))
-        data = getattr(self.backend, "data", None)
-        if data is not None and data.ncon:  # cheap test first; naming the pairs costs ~0.2 ms
-            self.contacts.extend((tick, t, pair) for pair in self.backend.contacts())
+        sim = self._simulated
+        if sim is not None and sim.data is not None and sim.data.ncon:  # naming the pairs costs ~0.2 ms
+            self.contacts.extend((tick, t, pair) for pair in sim.contacts())
 
     def __len__(self) -> int:
         return len(self.times)

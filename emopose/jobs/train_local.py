@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from emopose.bench.sequence_metrics import SequencePrediction, item_scores
 from emopose.bench.suites import SequenceItem
-from emopose.context import RunContext
+from emopose.resources import Run
 from emopose.jobs.report import markdown_table, write_results
 from emopose.planners.local import LocalPlanner, ScoredUtterance, trigger_span
 from emopose.planners.local_data import Example, load_examples
@@ -69,8 +69,9 @@ class TrainLocalJob:
             raise ValueError(f"job.search: {not_lists} must each be a list of numbers, "
                              "e.g. job.search={act_cost:[-1.0,-0.5]}")
 
-    def __call__(self, ctx: RunContext) -> dict:
-        planner = ctx.planner
+    def __call__(self, run: Run) -> dict:
+        res = run.resources
+        planner = res.planner
         if not isinstance(planner, LocalPlanner):
             raise ValueError("train_local needs planner=local")
         examples = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
@@ -95,6 +96,6 @@ class TrainLocalJob:
         text = (f"Local planner on the held-out training slice ({rows[0]['singles']} single-act, "
                 f"{rows[0]['sequences']} multi-act items)\n\n{table}")
         results = {"held_out": rows, "training": vars(planner.model.config)}
-        write_results(ctx.run_dir, results, text)
+        write_results(res.run_dir, results, text)
         print(text)
         return results

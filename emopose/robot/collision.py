@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from emopose.robot import kinematics as K
-from emopose.robot.kinematics import ARM_DOF, mirrored_chain, unmirror
+from emopose.robot.g1_spec import ARM_DOF
+from emopose.robot.kinematics import mirrored_chain, unmirror
 
 ARM_LINKS = ("upper_arm", "forearm", "hand")
 ARM_RADII = (0.04, 0.032, K.HAND_RADIUS)
@@ -120,12 +121,6 @@ def _segments(samples: np.ndarray, dtype: type) -> tuple[np.ndarray, np.ndarray]
     start = unmirror(start.transpose(0, 2, 1, 3).copy(), points=True).reshape(3, 8, n)[:, order]
     direction = unmirror(direction.transpose(0, 2, 1, 3).copy(), points=False).reshape(3, 8, n)
     return start, direction[:, order]
-
-
-def arm_segments(samples: np.ndarray, dtype: type = np.float64) -> tuple[np.ndarray, np.ndarray]:
-    """Start points and direction vectors (3, 6, T) of the arm capsules, in ARM_BODIES order."""
-    start, direction = _segments(samples, dtype)
-    return start[:, :6], direction[:, :6]
 
 
 @dataclass(frozen=True)

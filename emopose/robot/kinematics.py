@@ -21,11 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
-ARM_DOF = 7
+from emopose.robot.g1_spec import ARM_DOF
+
 LEFT, RIGHT = 0, 1
-JOINT_SUFFIXES = ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
-JOINT_SUFFIXES += ("wrist_roll", "wrist_pitch", "wrist_yaw")
-JOINT_NAMES = tuple(f"{side}_{j}_joint" for side in ("left", "right") for j in JOINT_SUFFIXES)
 MIRROR_SIGNS = np.array([1.0, -1.0, -1.0, 1.0, -1.0, 1.0, -1.0])  # q_right = MIRROR_SIGNS * q_left
 
 # Left chain from g1.md: body position in its parent, body quaternion (w x y z), joint axis

@@ -10,23 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from emopose.robot.g1_spec import JOINT_NAMES
+
 if TYPE_CHECKING:
     import mujoco
 
 ASSET_PATH = Path(__file__).parent / "assets" / "g1_upper_body.xml"
-
-_ARM_JOINTS = (
-    "shoulder_pitch",
-    "shoulder_roll",
-    "shoulder_yaw",
-    "elbow",
-    "wrist_roll",
-    "wrist_pitch",
-    "wrist_yaw",
-)
-JOINT_NAMES: tuple[str, ...] = tuple(
-    f"{side}_{joint}_joint" for side in ("left", "right") for joint in _ARM_JOINTS
-)
+# Slide x, slide y, hinge yaw (in this order); emopose.backends.planar_base drives them.
 BASE_JOINTS: tuple[str, ...] = ("base_x", "base_y", "base_yaw")
 
 
@@ -56,11 +46,7 @@ def build_spec(
         return spec
     pelvis = spec.body("pelvis")
     slide, hinge = mujoco.mjtJoint.mjJNT_SLIDE, mujoco.mjtJoint.mjJNT_HINGE
-    for name, jtype, axis in (
-        ("base_x", slide, [1, 0, 0]),
-        ("base_y", slide, [0, 1, 0]),
-        ("base_yaw", hinge, [0, 0, 1]),
-    ):
+    for name, jtype, axis in zip(BASE_JOINTS, (slide, slide, hinge), ([1, 0, 0], [0, 1, 0], [0, 0, 1])):
         pelvis.add_joint(name=name, type=jtype, axis=axis, damping=1.0)
         actuator = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         # The whole robot is ~20 kg; kv sets how stiffly the base follows the commanded velocity.

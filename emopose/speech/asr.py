@@ -12,6 +12,8 @@ import time
 from abc import ABC, abstractmethod
 from pathlib import Path
 
+from emopose.planners.llm_client import NO_KEY_PLACEHOLDER
+
 log = logging.getLogger(__name__)
 
 AUDIO_SUFFIXES = (".wav", ".mp3", ".m4a", ".ogg", ".oga", ".flac", ".webm", ".mp4", ".mpeg", ".mpga")
@@ -23,6 +25,7 @@ class ASRError(RuntimeError):
 
 class Recognizer(ABC):
     name = "base"
+    accepts_audio = True  # False: typed text only (the web page then hides its microphone)
 
     def utterance(self, text: str | None = None, audio: str | Path | None = None) -> str:
         """Typed text wins; otherwise the transcript of `audio`."""
@@ -41,6 +44,7 @@ class TypedText(Recognizer):
     """asr=none: the user types; audio input is refused with the way to enable it."""
 
     name = "none"
+    accepts_audio = False
 
     def transcribe(self, audio: str | Path) -> str:
         raise ASRError(f"asr=none cannot transcribe {audio}: type the utterance, or run with asr=litellm")
@@ -72,7 +76,8 @@ class LitellmTranscriber(Recognizer):
         try:
             with path.open("rb") as handle:
                 response = litellm.transcription(model=self.model, file=handle, api_base=self.api_base,
-                                                 api_key=self.api_key, timeout=self.timeout_s, **optional)
+                                                 api_key=self._api_key(litellm), timeout=self.timeout_s,
+                                                 **optional)
         except Exception as exc:
             raise ASRError(f"transcription of {path.name} by {self.model} at {self.api_base or 'provider default'} "
                            f"failed: {type(exc).__name__}: {str(exc)[:300]} (check asr.model, asr.api_base, "
@@ -81,3 +86,11 @@ class LitellmTranscriber(Recognizer):
         text = (getattr(response, "text", None) or "").strip()
         log.info("transcribed %s in %.2f s: %r", path.name, self.last_latency_s, text[:80])
         return text
+
+    def _api_key(self, litellm) -> str | None:
+        """The configured key; else the provider's env var; a keyless local server (asr.api_base set, no
+        key anywhere) gets a placeholder, because the OpenAI SDK refuses to send a request without one."""
+        if self.api_key or not self.api_base:
+            return self.api_key
+        return None if litellm.validate_environment(model=self.model).get("keys_in_environment") \
+            else NO_KEY_PLACEHOLDER

@@ -48,6 +48,12 @@ class Player:
         self.started_at, self.ends_at = start, start + clip.duration_s
         return start
 
+    def expected_latency_s(self, clip: SpeechClip, clock: Clock) -> float:
+        """How long after play() the clip will be heard: the sequence stage plans the speech start with it."""
+        if self._silent(clip, clock) or not self._probe():
+            return 0.0
+        return self.latency_s
+
     def playing(self, clock: Clock) -> bool:
         return self.ends_at is not None and clock.now() < self.ends_at
 
@@ -61,8 +67,11 @@ class Player:
             self._device.stop()
 
     # -- device --------------------------------------------------------------------------------
+    def _silent(self, clip: SpeechClip, clock: Clock) -> bool:
+        return self.sink == "none" or isinstance(clock, FakeClock) or clip.audio_path is None or clip.duration_s <= 0
+
     def _start_device(self, clip: SpeechClip, clock: Clock) -> float | None:
-        if self.sink == "none" or isinstance(clock, FakeClock) or clip.audio_path is None or clip.duration_s <= 0:
+        if self._silent(clip, clock):
             return None
         device = self._probe()
         if not device:

@@ -1,51 +1,49 @@
-"""Dispatch: run the submitted commands on the backend through the 50 Hz control loop.
+"""Dispatch: start the reply's audio and run the submitted commands through the 50 Hz control loop.
 
-When the loop already runs on its own thread (web UI, tour, G1), dispatch only waits if asked to;
+When the loop already runs on its own thread (web UI, tour, G1), dispatch waits on it if asked to;
 otherwise it drives the loop on this thread until the sequencer settles (offline rendering with a
 fake clock, or real time with the monotonic clock).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
-from emopose.sequencer import Event
+from emopose.control_loop import ControlLoop
+from emopose.sequencer import State
+from emopose.speech.player import Player
+from emopose.turn import DispatchReport, Turn
 
-
-@dataclass(frozen=True)
-class DispatchReport:
-    completed: bool
-    events: tuple[Event, ...]
-    ticks: int
+UNTIL = ("settle", "rest", "none")
 
 
 @dataclass
 class Dispatch:
-    """Stage: submitted -> dispatched. `settle` waits for HOLDING; `rest` also for the neutral recovery."""
+    """Stage: speech + submitted -> dispatched. `settle` waits until the last gesture ends (HOLDING),
+    `rest` also for the recovery to neutral, `none` returns at once."""
 
+    loop: ControlLoop = field(repr=False)
+    player: Player = field(repr=False)
     timeout_s: float = 60.0
     until: str = "rest"
     name = "dispatch"
-    reads = ("submitted",)
-    writes = "dispatched"
+    reads = ("speech", "submitted")
+    writes = ("dispatched",)
 
     def __post_init__(self) -> None:
-        if self.until not in ("settle", "rest", "none"):
-            raise ValueError(f"pipeline.dispatch.until must be settle, rest or none, got {self.until!r}")
+        if self.until not in UNTIL:
+            raise ValueError(f"pipeline.dispatch.until must be one of {UNTIL}, got {self.until!r}")
 
-    def __call__(self, turn, ctx) -> DispatchReport:
-        loop, sequencer = ctx.loop, ctx.sequencer
-        first_event = len(sequencer.events)
-        ticks = loop.stats.ticks
+    def __call__(self, turn: Turn) -> DispatchReport:
+        sequencer = self.loop.sequencer
+        speech_start = self.player.play(turn.speech, self.loop.clock)
+        first_event, ticks = len(sequencer.events), self.loop.stats.ticks
         if self.until == "none":
             done = True
         elif self.until == "settle":
-            done = self._wait(ctx, sequencer.settled)
+            done = self.loop.wait_until(sequencer.settled, self.timeout_s)
         else:
-            done = self._wait(ctx, lambda: sequencer.settled() and sequencer.state.value == "idle")
-        return DispatchReport(done, tuple(sequencer.events[first_event:]), loop.stats.ticks - ticks)
-
-    def _wait(self, ctx, done) -> bool:
-        if ctx.loop.running:
-            return ctx.wait_for(done, self.timeout_s)
-        return ctx.loop.run_until(done, self.timeout_s)
+            done = self.loop.wait_until(lambda: sequencer.settled() and sequencer.state == State.IDLE,
+                                        self.timeout_s)
+        return DispatchReport(done, tuple(sequencer.events[first_event:]), self.loop.stats.ticks - ticks,
+                              speech_start)

@@ -8,32 +8,15 @@ Duration is invariant.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from emopose.library import JointLimits
-from emopose.stages.resolve import ResolvedGesture
+from emopose.turn import ModulatedGesture, ResolvedGesture, Turn
 
 INTENSITY_GAINS = (0.4, 0.6, 1.0, 1.3, 1.6)
 LIMIT_MARGIN = 0.02
-
-
-@dataclass(frozen=True)
-class ModulatedGesture:
-    """A resolved gesture with its intensity-scaled (K, 14) keyframes and (unchanged) duration in s."""
-
-    resolved: ResolvedGesture
-    keyframes: np.ndarray
-    duration: float
-
-    @property
-    def name(self) -> str:
-        return self.resolved.entry.name
-
-    @property
-    def intensity(self) -> int:
-        return self.resolved.record.intensity
 
 
 def modulate_keyframes(q: np.ndarray, intensity: int, limits: JointLimits,
@@ -49,23 +32,28 @@ def modulate_keyframes(q: np.ndarray, intensity: int, limits: JointLimits,
 
 @dataclass
 class Modulate:
-    """Stage: resolved -> modulated."""
+    """Stage: resolved -> modulated, inside the robot's joint limits."""
 
+    limits: JointLimits = field(repr=False)
     gains: tuple[float, ...] = INTENSITY_GAINS
     margin: float = LIMIT_MARGIN
     name = "modulate"
     reads = ("resolved",)
-    writes = "modulated"
+    writes = ("modulated",)
 
     def __post_init__(self) -> None:
         self.gains = tuple(float(g) for g in self.gains)
         if len(self.gains) != 5 or self.gains[2] != 1.0:
             raise ValueError(f"pipeline.modulate.gains needs 5 values with level 3 = 1.0, got {self.gains}")
 
-    def __call__(self, turn, ctx) -> list[ModulatedGesture]:
-        return [self.modulate(r, ctx.library.limits) for r in turn.resolved]
+    def __call__(self, turn: Turn) -> list[ModulatedGesture]:
+        return [self.modulate(r) for r in turn.resolved]
 
-    def modulate(self, resolved: ResolvedGesture, limits: JointLimits) -> ModulatedGesture:
+    def keyframes(self, q: np.ndarray, intensity: int) -> np.ndarray:
+        """Eq. intensity with this stage's gains, margin and limits."""
+        return modulate_keyframes(q, intensity, self.limits, self.gains, self.margin)
+
+    def modulate(self, resolved: ResolvedGesture) -> ModulatedGesture:
         entry = resolved.entry
-        q = modulate_keyframes(entry.q, resolved.record.intensity, limits, self.gains, self.margin)
+        q = self.keyframes(entry.q, resolved.record.intensity)
         return ModulatedGesture(resolved, q, entry.default_duration)

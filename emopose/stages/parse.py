@@ -17,6 +17,7 @@ from typing import Any
 from emopose import CLASSES
 from emopose.contract import GestureRecord, Plan
 from emopose.planners.keyword import keyword_records
+from emopose.turn import Turn
 
 log = logging.getLogger(__name__)
 
@@ -130,7 +131,7 @@ class Parse:
 
     name = "parse"
     reads = ("request", "planner_output")
-    writes = "plan"
+    writes = ("plan",)
 
-    def __call__(self, turn, ctx) -> Plan:
+    def __call__(self, turn: Turn) -> Plan:
         return parse_plan(turn.planner_output.raw, turn.request.utterance)

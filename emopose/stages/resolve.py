@@ -9,34 +9,14 @@ its class default or to neutral instead of its named variant.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
-from emopose.contract import GestureRecord, LibraryEntry, Plan
+from emopose.contract import GestureRecord
 from emopose.library import MotionLibrary
+from emopose.turn import ResolvedGesture, Turn
 
 log = logging.getLogger(__name__)
-
-Rule = Literal["exact", "class_default", "neutral", "gated"]
-
-
-@dataclass(frozen=True)
-class ResolvedGesture:
-    record: GestureRecord
-    entry: LibraryEntry
-    rule: Rule
-
-    @property
-    def requested(self) -> str | None:
-        return self.record.variant
-
-    @property
-    def class_agrees(self) -> bool:
-        return self.entry.cls == self.record.cls
-
-    def audit(self) -> dict:
-        return {"class": self.record.cls, "requested": self.requested, "resolved": self.entry.name,
-                "resolved_class": self.entry.cls, "rule": self.rule, "confidence": self.record.confidence}
 
 
 def resolve_record(record: GestureRecord, library: MotionLibrary) -> ResolvedGesture:
@@ -53,28 +33,27 @@ def resolve_record(record: GestureRecord, library: MotionLibrary) -> ResolvedGes
 
 @dataclass
 class Resolve:
-    """Stage: plan -> resolved gestures. `min_confidence` enables gating; `gate_to` picks the fallback."""
+    """Stage: plan -> resolved gestures. `min_confidence` enables gating; `gate_to` picks the fallback.
 
+    The library is the live one: a motion saved in Pose Studio a moment ago resolves at once."""
+
+    library: MotionLibrary = field(repr=False)
     min_confidence: float | None = None
     gate_to: Literal["class_default", "neutral"] = "class_default"
     name = "resolve"
     reads = ("plan",)
-    writes = "resolved"
+    writes = ("resolved",)
 
     def __post_init__(self) -> None:
         if self.min_confidence is not None and not 0.0 <= self.min_confidence <= 1.0:
             raise ValueError(f"pipeline.resolve.min_confidence must be in [0, 1], got {self.min_confidence}")
 
-    def __call__(self, turn, ctx) -> list[ResolvedGesture]:
-        return [self.resolve(record, ctx.library) for record in turn.plan.records]
+    def __call__(self, turn: Turn) -> list[ResolvedGesture]:
+        return [self.resolve(record) for record in turn.plan.records]
 
-    def resolve(self, record: GestureRecord, library: MotionLibrary) -> ResolvedGesture:
+    def resolve(self, record: GestureRecord) -> ResolvedGesture:
         log.info("record %s/%s confidence %.2f", record.cls, record.variant, record.confidence)
         if self.min_confidence is None or record.confidence >= self.min_confidence:
-            return resolve_record(record, library)
-        fallback = library.class_default(record.cls) if self.gate_to == "class_default" else None
-        return ResolvedGesture(record, fallback or library.neutral_entry, "gated")
-
-
-def resolve_plan(plan: Plan, library: MotionLibrary) -> list[ResolvedGesture]:
-    return [resolve_record(record, library) for record in plan.records]
+            return resolve_record(record, self.library)
+        fallback = self.library.class_default(record.cls) if self.gate_to == "class_default" else None
+        return ResolvedGesture(record, fallback or self.library.neutral_entry, "gated")

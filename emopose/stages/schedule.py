@@ -11,36 +11,13 @@ back to the anchor equation where it has no word timings. Trigger search is case
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
-from emopose.speech.clip import SpeechClip
-from emopose.stages.modulate import ModulatedGesture
+from emopose.speech.clip import SpeechClip, Synthesizer
+from emopose.turn import Release, ReleaseRule, Schedule, Turn
 
 log = logging.getLogger(__name__)
-
-How = Literal["anchor", "words", "interpolated", "even", "immediate"]
-
-
-@dataclass(frozen=True)
-class Release:
-    release_s: float
-    how: How
-    trigger_found: bool
-
-
-@dataclass(frozen=True)
-class Schedule:
-    reply: str
-    speech: SpeechClip
-    releases: tuple[Release, ...]
-    gestures: tuple[ModulatedGesture, ...]
-
-    @property
-    def missing_triggers(self) -> list[int]:
-        """Indices of records whose trigger is not in the reply (the say-do check)."""
-        return [k for k, r in enumerate(self.releases) if not r.trigger_found]
-
 
 def trigger_position(reply: str, trigger: str | None) -> int | None:
     if not trigger:
@@ -49,7 +26,7 @@ def trigger_position(reply: str, trigger: str | None) -> int | None:
     return pos if pos >= 0 else None
 
 
-def anchor_release_times(reply: str, triggers: list[str | None], duration_s: float) -> list[tuple[float, How]]:
+def anchor_release_times(reply: str, triggers: list[str | None], duration_s: float) -> list[tuple[float, ReleaseRule]]:
     """The paper's schedule equation with its interpolation and even-spacing rules."""
     count = len(triggers)
     length = max(len(reply), 1)
@@ -63,7 +40,7 @@ def anchor_release_times(reply: str, triggers: list[str | None], duration_s: flo
             return [(0.0, "immediate")]
         return [(duration_s * (k + 0.5) / count, "even") for k in range(count)]
     anchors = sorted(matched.items())
-    out: list[tuple[float, How]] = []
+    out: list[tuple[float, ReleaseRule]] = []
     for k in range(count):
         if k in matched:
             out.append((matched[k], "anchor"))
@@ -75,7 +52,7 @@ def anchor_release_times(reply: str, triggers: list[str | None], duration_s: flo
     return out
 
 
-def word_release_times(reply: str, triggers: list[str | None], speech: SpeechClip) -> list[tuple[float, How]]:
+def word_release_times(reply: str, triggers: list[str | None], speech: SpeechClip) -> list[tuple[float, ReleaseRule]]:
     """True word onsets where the trigger is found and the synthesizer gave word timings."""
     out = anchor_release_times(reply, triggers, speech.duration_s)
     for k, trigger in enumerate(triggers):
@@ -88,20 +65,22 @@ def word_release_times(reply: str, triggers: list[str | None], speech: SpeechCli
 
 @dataclass
 class ScheduleStage:
-    """Stage: plan + modulated -> schedule. Synthesizes the reply with ctx.speech for T_a."""
+    """Stage: plan + modulated -> speech + schedule. Its synthesizer gives the reply's audio, T_a and
+    word onsets."""
 
+    synthesizer: Synthesizer = field(repr=False)
     mode: Literal["anchor", "words"] = "anchor"
     name = "schedule"
     reads = ("plan", "modulated")
-    writes = "schedule"
+    writes = ("speech", "schedule")
 
     def __post_init__(self) -> None:
         if self.mode not in ("anchor", "words"):
             raise ValueError(f"pipeline.schedule.mode must be 'anchor' or 'words', got {self.mode!r}")
 
-    def __call__(self, turn, ctx) -> Schedule:
+    def __call__(self, turn: Turn) -> tuple[SpeechClip, Schedule]:
         reply = turn.plan.reply
-        speech = ctx.speech.synthesize(reply)
+        speech = self.synthesizer.synthesize(reply)
         triggers = [m.resolved.record.trigger for m in turn.modulated]
         times = (word_release_times(reply, triggers, speech) if self.mode == "words"
                  else anchor_release_times(reply, triggers, speech.duration_s))
@@ -110,4 +89,4 @@ class ScheduleStage:
         )
         for k in [k for k, r in enumerate(releases) if not r.trigger_found and triggers[k]]:
             log.warning("say-do check: trigger %r of record %d is not in the reply", triggers[k], k)
-        return Schedule(reply, speech, releases, tuple(turn.modulated))
+        return speech, Schedule(reply, releases, tuple(turn.modulated))

@@ -1,6 +1,6 @@
 """Pose Studio's view of a draft motion: the trajectory the robot would run, and the checks before saving.
 
-The preview runs the execution code itself: Eq. intensity (modulate_keyframes with the pipeline's
+The preview runs the execution code itself: Eq. intensity (the Modulate stage with the pipeline's
 gains and margin), Eq. smoothstep (TrajectoryBuilder.build) from the neutral rest pose, and the
 sequencer's own safety hook; so what Pose Studio shows is what the sequencer would accept or reject.
 Every intensity level is checked, because the planner may ask for any of them.
@@ -17,7 +17,7 @@ from pydantic import ValidationError
 from emopose.contract import LibraryEntry
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
-from emopose.stages.modulate import INTENSITY_GAINS, LIMIT_MARGIN, modulate_keyframes
+from emopose.stages.modulate import Modulate
 from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 LEVELS = (1, 2, 3, 4, 5)
@@ -67,21 +67,15 @@ class DraftReport:
 
 
 class PoseStudio:
-    def __init__(self, library: MotionLibrary, safety: Callable[[np.ndarray], str | None] | None = None,
-                 checker: SelfCollisionChecker | None = None, gains: tuple[float, ...] = INTENSITY_GAINS,
-                 margin: float = LIMIT_MARGIN) -> None:
+    def __init__(self, library: MotionLibrary, modulate: Modulate | None = None,
+                 safety: Callable[[np.ndarray], str | None] | None = None,
+                 checker: SelfCollisionChecker | None = None) -> None:
+        """`modulate`: the running pipeline's stage (its gains and margin), else the paper's law;
+        `safety`: the sequencer's hook, so a draft is judged as execution would judge it."""
         self.library, self.safety = library, safety
+        self.modulate = modulate or Modulate(library.limits)
         self.checker = checker or SelfCollisionChecker()
-        self.gains, self.margin = tuple(gains), margin
         self.builder = TrajectoryBuilder(library.limits)
-
-    @classmethod
-    def from_context(cls, ctx) -> PoseStudio:
-        """Use the running pipeline's modulation constants and the sequencer's safety hook."""
-        modulate = next((s for s in ctx.pipeline.stages if s.name == "modulate"), None)
-        gains = getattr(modulate, "gains", INTENSITY_GAINS)
-        margin = getattr(modulate, "margin", LIMIT_MARGIN)
-        return cls(ctx.library, ctx.sequencer.safety, gains=gains, margin=margin)
 
     def draft(self, keyframes: list[list[float]], motion_type: str = "sequence",
               duration: float | None = None) -> LibraryEntry:
@@ -98,7 +92,7 @@ class PoseStudio:
         start = self.library.neutral_entry.q[0]
         levels, chosen = [], None
         for level in LEVELS:
-            q = modulate_keyframes(entry.q, level, self.library.limits, self.gains, self.margin)
+            q = self.modulate.keyframes(entry.q, level)
             trajectory = self.builder.build(q, entry.default_duration, start)
             levels.append(self._check(level, trajectory))
             if level == intensity:

@@ -1,12 +1,12 @@
 """Aim stage (conf/pipeline/tour.yaml): retarget pointing gestures at the object they refer to.
 
 Runs after modulate and rewrites `modulated` (the pipeline lets a later stage replace a field).
-For each pointing record whose target the scene knows (ctx.scene, see scene_view.py), the gesture
+For each pointing record whose target the scene knows (its SceneSlot, see scene_view.py), the gesture
 is mirrored onto the arm on the target's side when needed, and every "peak" keyframe (an interior
 keyframe whose arm excursion reaches `peak_fraction` of the largest) is replaced by an IK solution
 that aims the hand's pointing axis at the target. The approach and return keyframes stay the
 library's. A target the arm cannot aim at exactly gets the closest aim (reported as not converged).
-If the aimed keyframes fail the sequencer's self-collision check, the library motion is kept.
+If the aimed keyframes fail the configured self-collision check, the library motion is kept.
 Without a scene the stage passes everything through unchanged.
 """
 
@@ -14,13 +14,18 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 
 import numpy as np
 
-from emopose.robot.kinematics import ARM_DOF, mirror
+from emopose.library import JointLimits
+from emopose.robot.g1_spec import ARM_DOF
+from emopose.robot.kinematics import mirror
 from emopose.tour.pointing_ik import aim_arm
+from emopose.tour.scene_view import SceneSlot
+from emopose.turn import ModulatedGesture, Turn
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +68,9 @@ def _densify(keyframes: np.ndarray, per_segment: int = 8) -> np.ndarray:
 class AimStage:
     """Stage: modulated -> modulated (pointing peaks aimed at the scene's target)."""
 
+    scene: SceneSlot = field(repr=False)
+    limits: JointLimits = field(repr=False)
+    safety: Callable[[np.ndarray], str | None] | None = field(default=None, repr=False)
     classes: tuple[str, ...] = ("pointing",)
     skip: tuple[str, ...] = ("point_to_self",)  # deictic to the robot itself: never aimed elsewhere
     peak_fraction: float = 0.6
@@ -72,7 +80,7 @@ class AimStage:
     abductions: tuple[float, ...] = (0.0, 0.3, 0.6)  # rad of extra shoulder roll to retry with on a collision
     name = "aim"
     reads = ("plan", "modulated")
-    writes = "modulated"
+    writes = ("modulated",)
 
     def __post_init__(self) -> None:
         if not 0.0 < self.peak_fraction <= 1.0:
@@ -80,8 +88,8 @@ class AimStage:
         self.classes, self.skip = tuple(self.classes), tuple(self.skip)
         self.abductions = tuple(float(a) for a in self.abductions) or (0.0,)
 
-    def __call__(self, turn, ctx) -> list:
-        scene = getattr(ctx, "scene", None)
+    def __call__(self, turn: Turn) -> list[ModulatedGesture]:
+        scene = self.scene.view
         if scene is None:
             return list(turn.modulated)
         out = []
@@ -94,20 +102,20 @@ class AimStage:
             if target is None:
                 out.append(gesture)
                 continue
-            keyframes, report = self.aim(gesture.keyframes, scene.in_torso(target), ctx, gesture.name, target.name)
+            keyframes, report = self.aim(gesture.keyframes, scene.in_torso(target), gesture.name, target.name)
             scene.aims.append(report)
             out.append(replace(gesture, keyframes=keyframes) if report.applied else gesture)
         return out
 
-    def aim(self, keyframes: np.ndarray, target: np.ndarray, ctx, gesture: str = "", target_name: str = ""):
+    def aim(self, keyframes: np.ndarray, target: np.ndarray, gesture: str = "", target_name: str = ""):
         """Aimed (K, 14) keyframes for a torso-frame target, and the report."""
         side = active_side(keyframes)
         wanted = 0 if target[1] > self.side_switch_m else 1 if target[1] < -self.side_switch_m else side
         mirrored = wanted != side
         base = mirror(keyframes) if mirrored else np.array(keyframes, float)  # the limits are mirror images
-        safety = getattr(ctx.sequencer, "safety", None)
+        safety = self.safety
         for abduction in self.abductions:  # a pose that brushes the torso is retried with the arm further out
-            aimed, errors, converged = self._solve(base, wanted, target, ctx.library.limits, abduction)
+            aimed, errors, converged = self._solve(base, wanted, target, self.limits, abduction)
             reason = safety(_densify(aimed)) if safety is not None else None
             if not reason:
                 break

@@ -11,6 +11,8 @@ import io
 import logging
 from typing import Protocol
 
+from emopose.backends.capabilities import Renderable
+
 log = logging.getLogger(__name__)
 
 
@@ -47,4 +49,4 @@ class NoCamera:
 
 
 def camera_for(backend) -> Camera:
-    return MujocoHeadCamera(backend) if getattr(backend, "name", "") == "mujoco" else NoCamera()
+    return MujocoHeadCamera(backend) if isinstance(backend, Renderable) else NoCamera()

@@ -11,14 +11,21 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
 
+from emopose.backends.base import Backend
+from emopose.backends.capabilities import PlanarBase, SimulatedState
+from emopose.backends.g1.backend import G1Backend
 from emopose.clock import FakeClock
 from emopose.jobs.report import write_results
+from emopose.library import MotionLibrary
+from emopose.planners.base import Planner
+from emopose.resources import Run
 from emopose.tour.camera import camera_for
+from emopose.tour.g1_base import G1Base
+from emopose.tour.navigator import MobileBase
 from emopose.tour.runner import TourRunner
 from emopose.tour.scenario import TourConfigError, TourSpec, load_tour, parse_tour
+from emopose.tour.sim_base import MujocoBase
 from emopose.tour.sim_scene import install_scene
 
 log = logging.getLogger(__name__)
@@ -41,69 +48,67 @@ class TourJob:
         name = self.tour.get("name") if isinstance(self.tour, dict) else None
         return parse_tour(self.tour, f"conf/tour/{name}.yaml" if name else "tour config")
 
-    def __call__(self, ctx) -> dict:
-        spec = self.load()
-        install_scene(ctx.backend, spec, Path(ctx.run_dir), self.video)
-        ctx.open()
-        base = self.make_base(ctx, spec)
-        if not isinstance(ctx.clock, FakeClock):
-            ctx.loop.start()  # real time: the loop streams on its own thread, the tour waits on it
-        runner = TourRunner(ctx, spec, base, camera_for(ctx.backend), answer_planner=self.answering_planner(ctx))
+    def __call__(self, run: Run) -> dict:
+        spec, res = self.load(), run.resources
+        install_scene(res.backend, spec, res.run_dir, self.video)
+        loop = run.session.open()
+        base = self.make_base(res.backend, spec)
+        if not isinstance(res.clock, FakeClock):
+            loop.start()  # real time: the loop streams on its own thread, the tour waits on it
+        runner = TourRunner(run, spec, base, camera_for(res.backend),
+                            answer_planner=self.answering_planner(res.planner, res.library))
         started = time.perf_counter()
         try:
             report = runner.run()
         finally:
-            if hasattr(base, "loco"):
+            if isinstance(base, G1Base):
                 base.loco.close()  # the G1's loco client (the runner has already stopped the base)
         wall_s = time.perf_counter() - started
         results = {**report.as_dict(), "wall_time_s": wall_s,
                    "realtime_factor": report.sim_time_s / wall_s if wall_s > 0 else None,
-                   "planner": ctx.planner.name, "backend": ctx.backend.name,
+                   "planner": res.planner.name, "backend": res.backend.name,
                    "stop_tolerance_m": spec.navigation.stop_tolerance_m,
-                   "mcap": str(ctx.recorder.path) if ctx.recorder else None,
-                   "video": getattr(ctx.backend, "video_path", None)}
+                   "mcap": str(run.session.recorder.path) if run.session.recorder else None,
+                   "video": res.backend.renderer.video_path if isinstance(res.backend, SimulatedState) else None}
         text = report.markdown() + f"\n\nWall time {wall_s:.1f} s."
-        write_results(Path(ctx.run_dir), results, text)
+        write_results(res.run_dir, results, text)
         print(text)
         return results
 
-    def make_base(self, ctx, spec: TourSpec):
+    def make_base(self, backend: Backend, spec: TourSpec) -> MobileBase:
         start = spec.start.pose()
-        if ctx.backend.name == "mujoco":
-            from emopose.tour.sim_base import MujocoBase
-
+        if isinstance(backend, SimulatedState) and isinstance(backend.planar_base, PlanarBase):
             noise = spec.odometry_noise
-            base = MujocoBase(ctx.backend, noise.velocity_std, noise.yaw_rate_std, noise.seed)
+            base = MujocoBase(backend.planar_base, noise.velocity_std, noise.yaw_rate_std, noise.seed)
             base.place(start)
             return base
-        if ctx.backend.name == "g1":
-            return self._g1_base(ctx, spec)
-        raise TourConfigError(f"the tour needs a mobile base: backend={ctx.backend.name} has none; "
-                              "use backend=mujoco (backend.planar_base=true) or backend=g1")
+        if isinstance(backend, G1Backend):
+            return self._g1_base(backend, spec)
+        raise TourConfigError(f"the tour needs a mobile base: backend={backend.name} has none; use backend=mujoco "
+                              "with a backend.planar_base (as +experiment=tour_lab sets) or backend=g1")
 
-    def _g1_base(self, ctx, spec: TourSpec):
+    def _g1_base(self, backend: Backend, spec: TourSpec) -> MobileBase:
         from hydra.utils import get_method
 
         from emopose.backends.g1 import LocoClient
-        from emopose.tour.g1_base import G1Base
 
         if not self.g1_odometry:
             raise TourConfigError("the tour on the G1 walks on onboard odometry: set job.g1_odometry to a "
                                   "factory (loco, backend) -> callable returning emopose.tour.geometry.Pose2D")
-        settings = ctx.backend.settings
+        settings = backend.settings
         loco = LocoClient(domain_id=settings.domain_id, network_interface=settings.network_interface,
                           max_vx=spec.navigation.max_vx, max_omega=spec.navigation.max_wz).open()
-        odometry = get_method(self.g1_odometry)(loco, ctx.backend)
+        odometry = get_method(self.g1_odometry)(loco, backend)
         return G1Base(loco, odometry, origin=spec.start.pose())
 
-    def answering_planner(self, ctx) -> Any:
-        """ctx.planner, or a sibling in answer_mode when the configured planner narrates (llm)."""
+    def answering_planner(self, planner: Planner, library: MotionLibrary) -> Planner:
+        """The run's planner, or a sibling in answer_mode when the configured planner narrates (llm)."""
         node = self.answer_planner
         if not node or "mode" not in node or node["mode"] == self.answer_mode:
-            return ctx.planner
+            return planner
         from omegaconf import OmegaConf
 
         from emopose.build import make
 
         log.info("tour: answering questions with a %s-mode copy of the planner", self.answer_mode)
-        return make(OmegaConf.create({**node, "mode": self.answer_mode}), "job.answer_planner", library=ctx.library)
+        return make(OmegaConf.create({**node, "mode": self.answer_mode}), "job.answer_planner", library=library)

@@ -13,13 +13,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
+from emopose.backends.capabilities import PlanarBase, SimulatedState
+from emopose.contract import LibraryEntry
 from emopose.jobs.report import markdown_table, write_results
+from emopose.resources import Run
 from emopose.robot.kinematics import HAND_ORIGIN
 from emopose.sequencer import GestureCommand
+from emopose.session import Session
 from emopose.tour.aim import AimStage, peak_indices
 from emopose.tour.geometry import Pose2D, angle_between, map_to_torso, torso_to_map
 from emopose.tour.pointing_ik import pointing_error
@@ -41,18 +44,22 @@ class PointingEvalJob:
     settle_s: float = 1.0
     max_error_deg: float = 5.0
 
-    def __call__(self, ctx) -> dict:
+    def __call__(self, run: Run) -> dict:
         spec = load_tour(self.tour_file) if self.tour_file else parse_tour(self.tour, "tour config")
-        if ctx.backend.name != "mujoco":
-            raise TourConfigError("pointing_eval measures in simulation: use backend=mujoco")
-        install_scene(ctx.backend, spec, Path(ctx.run_dir), video=False)
-        ctx.open()
-        base = MujocoBase(ctx.backend)
-        entry = ctx.library.get(self.gesture) if self.gesture else ctx.library.class_default("pointing")
+        res = run.resources
+        if not (isinstance(res.backend, SimulatedState) and isinstance(res.backend.planar_base, PlanarBase)):
+            raise TourConfigError("pointing_eval measures in simulation with a planar base: use backend=mujoco "
+                                  "with a backend.planar_base (as +experiment=pointing_eval sets)")
+        install_scene(res.backend, spec, res.run_dir, video=False)
+        run.session.open()
+        base = MujocoBase(res.backend.planar_base)
+        entry = res.library.get(self.gesture) if self.gesture else res.library.class_default("pointing")
         if entry is None:
             raise TourConfigError(f"pointing_eval: no pointing motion {self.gesture!r} in the library")
-        stage = next((s for s in ctx.pipeline.stages if isinstance(s, AimStage)), AimStage())
-        rows = [self.trial(ctx, base, stage, entry, pose, name, target) for name, pose, target in self.targets(spec)]
+        # The configured aim stage (pipeline=tour), else one with the stage's defaults and the run's limits.
+        stage = res.pipeline.get("aim") or AimStage(res.scene, res.library.limits, res.sequencer.safety)
+        rows = [self.trial(run.session, base, stage, entry, pose, name, target)
+                for name, pose, target in self.targets(spec)]
         reachable = [r for r in rows if r["reachable"]]
         worst = max((r["sim_error_deg"] for r in reachable), default=float("nan"))
         results = {
@@ -69,7 +76,7 @@ class PointingEvalJob:
         text = (f"# Pointing accuracy ({entry.name})\n\n{table}\n\n{len(reachable)}/{len(rows)} reachable; "
                 f"worst simulated error {worst:.2f} deg (limit {self.max_error_deg} deg), FK worst "
                 f"{results['max_fk_error_deg']:.2f} deg.")
-        write_results(Path(ctx.run_dir), results, text)
+        write_results(res.run_dir, results, text)
         print(text)
         return results
 
@@ -86,23 +93,24 @@ class PointingEvalJob:
                 out.append((f"probe az {az:+.0f} el {el:+.0f}", start, torso_to_map(local, start)))
         return out
 
-    def trial(self, ctx, base: MujocoBase, stage: AimStage, entry, pose: Pose2D, name: str, target: np.ndarray) -> dict:
-        neutral = ctx.library.neutral_entry.q[0]
-        ctx.backend.reset(neutral)  # arms at rest, base at the origin; then stand at the pose
+    def trial(self, session: Session, base: MujocoBase, stage: AimStage, entry: LibraryEntry, pose: Pose2D,
+              name: str, target: np.ndarray) -> dict:
+        loop, backend, sequencer = session.loop, session.backend, session.loop.sequencer
+        backend.reset(session.neutral)  # arms at rest, base at the origin; then stand at the pose
         base.place(pose)
-        ctx.loop.begin(neutral)
+        loop.begin(session.neutral, session.recorder)
         local = map_to_torso(target, pose)
-        aimed, report = stage.aim(entry.q, local, ctx, entry.name, name)
+        aimed, report = stage.aim(entry.q, local, entry.name, name)
         side = 0 if report.side == "left" else 1
         last = peak_indices(aimed, side, stage.peak_fraction)[-1]
         duration = entry.default_duration * last / max(len(aimed) - 1, 1)
-        ctx.sequencer.submit(GestureCommand(entry.name, aimed[: last + 1], max(duration, 0.5), label="pointing"))
-        ctx.loop.run_until(ctx.sequencer.settled, timeout_s=20.0)
-        ctx.loop.run_until(lambda: False, timeout_s=self.settle_s)  # hold the pose and let the servos settle
-        sim_error = self.measure(ctx.backend, side, target)
+        sequencer.submit(GestureCommand(entry.name, aimed[: last + 1], max(duration, 0.5), label="pointing"))
+        loop.run_until(sequencer.settled, timeout_s=20.0)
+        loop.run_until(lambda: False, timeout_s=self.settle_s)  # hold the pose and let the servos settle
+        sim_error = self.measure(backend, side, target)
         return {"target": name, "side": report.side, "mirrored": report.mirrored,
                 "fk_error_deg": math.degrees(pointing_error(aimed[last], side, local)),
-                "fk_measured_deg": math.degrees(pointing_error(ctx.backend.measured(), side, local)),
+                "fk_measured_deg": math.degrees(pointing_error(backend.measured(), side, local)),
                 "sim_error_deg": sim_error, "reachable": report.converged and report.applied,
                 "ik_converged": report.converged, "collision": report.reason}
 

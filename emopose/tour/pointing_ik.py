@@ -16,7 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from emopose.robot.kinematics import ARM_DOF, AXES, HAND_ORIGIN, hand_jacobian, link_frames
+from emopose.robot.g1_spec import ARM_DOF
+from emopose.robot.kinematics import AXES, HAND_ORIGIN, hand_jacobian, link_frames
 from emopose.tour.geometry import angle_between
 
 JOINT_WEIGHTS = np.array([1.0, 1.0, 1.5, 1.2, 3.0, 4.0, 4.0])  # shoulder x3, elbow, wrist x3

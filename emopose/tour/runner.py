@@ -15,8 +15,11 @@ import logging
 import math
 from functools import partial
 
+from emopose.planners.base import Planner
+from emopose.resources import Run
+from emopose.tour.camera import Camera
 from emopose.tour.interruptions import Interruptions, Question, asks_about_scene, wants_abort
-from emopose.tour.navigator import NavigationSettings, Navigator
+from emopose.tour.navigator import MobileBase, NavigationSettings, Navigator
 from emopose.tour.report import Exchange, StopResult, TourReport
 from emopose.tour.scenario import StopSpec, TourSpec
 from emopose.tour.scene_view import SceneView
@@ -29,22 +32,27 @@ DEFAULT_ANSWER = "That is a good question; let me tell you more about it after t
 
 
 class TourRunner:
-    def __init__(self, ctx, spec: TourSpec, base, camera, interruptions: Interruptions | None = None,
-                 answer_planner=None) -> None:
-        self.ctx, self.spec, self.base, self.camera = ctx, spec, base, camera
-        self.world = TourWorld(ctx, base)
-        self.voice = TourVoice(self.world)
+    """Runs one tour in `run`: its turn runner says the lines and keeps the dialogue history, and the
+    resources' scene slot tells the aim stage what the robot is looking at."""
+
+    def __init__(self, run: Run, spec: TourSpec, base: MobileBase, camera: Camera,
+                 interruptions: Interruptions | None = None, answer_planner: Planner | None = None) -> None:
+        res = run.resources
+        self.spec, self.base, self.camera = spec, base, camera
+        self.turns, self.sequencer, self.scene = run.runner, res.sequencer, res.scene
+        self.world = TourWorld(run.session, res.clock, base)
+        self.voice = TourVoice(self.world, run.runner, res.synthesizer, res.player, res.sequencer)
         self.navigator = Navigator(base, NavigationSettings(**spec.navigation.model_dump()),
                                    self.world.advance, self.world.now, self.world.dt)
         self.interruptions = interruptions or Interruptions(spec.interruptions)
-        self.answer_planner = answer_planner or ctx.planner
+        self.answer_planner = answer_planner or res.planner
         self.report = TourReport(spec.name)
         self.aborted = False
         self._moving_when_asked = False
 
     # -- the tour ----------------------------------------------------------------------------
     def run(self) -> TourReport:
-        first_event = len(self.ctx.sequencer.events)
+        first_event = len(self.sequencer.events)
         self.event("start", pose=self.base.odometry().as_dict())
         try:
             for stop in self.spec.stops_in_order:
@@ -57,17 +65,17 @@ class TourRunner:
             if not self.aborted and self.spec.closing:
                 closing = self.say(self.spec.closing, "closing")
                 self.voice.finish(closing)
-                self.ctx.history.append({"role": "assistant", "content": closing.text})
+                self.turns.history.append({"role": "assistant", "content": closing.text})
         finally:
             self.come_to_rest()
-            self.report.finish(self.ctx.sequencer.events[first_event:], self.aborted,
+            self.report.finish(self.sequencer.events[first_event:], self.aborted,
                                [q.text for q in self.interruptions.unasked])
             self.event("end", aborted=self.aborted, at_rest=self.report.ended_at_rest)
         return self.report
 
     def walk_to(self, stop: StopSpec) -> StopResult:
         goal = stop.pose.pose()
-        self.ctx.scene = SceneView.walking(self.base.odometry(), self.spec.objects)
+        self.scene.view = SceneView.walking(self.base.odometry(), self.spec.objects)
         if not self.spec.gesture_while_walking:
             self.voice.to_rest()
         if stop.approach:
@@ -75,11 +83,11 @@ class TourRunner:
                 self.say(stop.approach, "approach")
             else:
                 self.voice.speak_only(stop.approach, "approach")
-            self.ctx.history.append({"role": "assistant", "content": stop.approach})
+            self.turns.history.append({"role": "assistant", "content": stop.approach})
         self.event("depart", stop=stop.name, goal=goal.as_dict())
-        events_before, exchanges_before = len(self.ctx.sequencer.events), len(self.report.exchanges)
+        events_before, exchanges_before = len(self.sequencer.events), len(self.report.exchanges)
         leg = self.navigator.go_to(goal, poll=lambda t: self._poll("leg", stop.name, t), handle=self.answer)
-        started = sum(e.kind == "started" for e in self.ctx.sequencer.events[events_before:])
+        started = sum(e.kind == "started" for e in self.sequencer.events[events_before:])
         answered = sum(len(x.gestures) for x in self.report.exchanges[exchanges_before:])  # given standing
         true_pose = getattr(self.base, "true_pose", None)
         truth = true_pose() if true_pose is not None else None
@@ -96,9 +104,9 @@ class TourRunner:
 
     def narrate(self, stop: StopSpec, result: StopResult) -> None:
         scene = SceneView.at(self.base.odometry(), stop, self.spec.objects)
-        self.ctx.scene = scene
+        self.scene.view = scene
         pieces, offset = sentence_chunks(stop.narration), 0.0
-        events_before = len(self.ctx.sequencer.events)
+        events_before = len(self.sequencer.events)
         while pieces and not self.aborted:
             line = self.say(pieces.pop(0), "narration")
             # Scripted questions count time from the start of the whole narration, across its pieces.
@@ -106,7 +114,7 @@ class TourRunner:
             # Between pieces of one narration the next piece's gestures may queue behind this one's.
             question = self.voice.finish(line, poll=poll, wait_for_gestures=not pieces)
             result.narration.append(line.text)
-            self.ctx.history.append({"role": "assistant", "content": _spoken(line)})
+            self.turns.history.append({"role": "assistant", "content": _spoken(line)})
             offset += line.stopped_at_s if question is not None else line.speech.duration_s
             if question is None:
                 continue
@@ -115,8 +123,8 @@ class TourRunner:
                 pieces.insert(0, line.remaining())
             if not self.answer(question):
                 break
-            self.ctx.scene = scene  # the answer may have updated the view
-        result.add_events(self.ctx.sequencer.events[events_before:], scene.aims)
+            self.scene.view = scene  # the answer may have updated the view
+        result.add_events(self.sequencer.events[events_before:], scene.aims)
 
     # -- questions ---------------------------------------------------------------------------
     def _poll(self, where: str, stop: str, elapsed_s: float) -> Question | None:
@@ -133,10 +141,10 @@ class TourRunner:
         walking = question.where.startswith("leg") or self._moving_when_asked
         self.event("question", text=question.text, where=question.where, base_moving=self._moving_when_asked)
         self.voice.cut_short()
-        if isinstance(self.ctx.scene, SceneView):
-            self.ctx.scene.base = self.base.odometry()
+        if self.scene.view is not None:
+            self.scene.view.base = self.base.odometry()
         exchange = Exchange(question.text, question.where, self.world.stream_time, self._moving_when_asked)
-        events_before = len(self.ctx.sequencer.events)
+        events_before = len(self.sequencer.events)
         if wants_abort(question.text):
             line = self.say(self.spec.abort_reply, "abort", extra_history=_asked(question))
             exchange.aborted = self.aborted = True
@@ -150,9 +158,9 @@ class TourRunner:
                                 extra_history=_asked(question))
         self.voice.finish(line)
         exchange.answer = line.text
-        exchange.gestures = [e.name for e in self.ctx.sequencer.events[events_before:] if e.kind == "started"]
-        self.ctx.history.extend([{"role": "user", "content": question.text},
-                                 {"role": "assistant", "content": line.text}])
+        exchange.gestures = [e.name for e in self.sequencer.events[events_before:] if e.kind == "started"]
+        self.turns.history.extend([{"role": "user", "content": question.text},
+                                   {"role": "assistant", "content": line.text}])
         self.report.exchanges.append(exchange)
         if walking and not self.spec.gesture_while_walking:
             self.voice.to_rest()
@@ -160,7 +168,7 @@ class TourRunner:
         return not self.aborted
 
     # -- helpers -----------------------------------------------------------------------------
-    def say(self, text: str, kind: str, image: bytes | None = None, planner=None,
+    def say(self, text: str, kind: str, image: bytes | None = None, planner: Planner | None = None,
             extra_history: tuple[dict, ...] = ()) -> Line:
         line = self.voice.perform(text, kind, image, planner, extra_history)
         self.event("say", kind=kind, text=line.text, speech_s=line.speech.duration_s)
@@ -168,7 +176,7 @@ class TourRunner:
 
     def come_to_rest(self) -> None:
         self.navigator.halt()
-        sequencer = self.ctx.sequencer
+        sequencer = self.sequencer
         if sequencer.active is not None or sequencer.pending:
             self.voice.cut_short()
         self.voice.to_rest(timeout_s=10.0)

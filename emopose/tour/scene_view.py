@@ -1,8 +1,9 @@
 """What the robot knows about its surroundings when it plans a gesture: objects and its own pose.
 
-The tour keeps `ctx.scene` up to date (the current stop's objects, the odometry pose); the aim stage
-asks it which object a pointing record means: one the trigger (or the sentence around it) names,
-else the stop's designated or only object. Without a scene (no tour) nothing is aimed.
+The tour keeps the run's SceneSlot up to date (the current stop's objects, the odometry pose); the aim
+stage, which holds the same slot, asks its view which object a pointing record means: one the trigger
+(or the sentence around it) names, else the stop's designated or only object. With an empty slot (no
+tour) nothing is aimed.
 """
 
 from __future__ import annotations
@@ -75,3 +76,11 @@ def _sentence_around(reply: str, trigger: str | None) -> str:
     start = max(reply.rfind(m, 0, pos) for m in ".!?") + 1
     ends = [e for e in (reply.find(m, pos) for m in ".!?") if e >= 0]
     return reply[start:(min(ends) + 1 if ends else len(reply))]
+
+
+@dataclass
+class SceneSlot:
+    """The view the robot plans in right now: set by whoever knows the surroundings (the tour), read by
+    the aim stage; None when nobody does."""
+
+    view: SceneView | None = None

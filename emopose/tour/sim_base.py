@@ -1,4 +1,4 @@
-"""The MuJoCo planar base (backend.planar_base=true) as a MobileBase, with dead-reckoning odometry.
+"""The simulated planar base (a PlanarBase, e.g. the MuJoCo backend's) as a MobileBase, with dead-reckoning odometry.
 
 Odometry integrates the base's body-frame velocity each control period, as leg odometry does,
 with optional seeded Gaussian noise on the velocities, so it drifts from the simulated truth the
@@ -13,22 +13,15 @@ import math
 
 import numpy as np
 
+from emopose.backends.capabilities import PlanarBase
 from emopose.tour.geometry import Pose2D, wrap_angle
-
-BASE_JOINTS = ("base_x", "base_y", "base_yaw")
 
 
 class MujocoBase:
-    def __init__(self, backend, velocity_std: float = 0.0, yaw_rate_std: float = 0.0, seed: int = 0,
+    def __init__(self, base: PlanarBase, velocity_std: float = 0.0, yaw_rate_std: float = 0.0, seed: int = 0,
                  rest_speed: float = 0.01) -> None:
-        if backend.data is None:
-            raise RuntimeError("MujocoBase needs a connected mujoco backend (ctx.open() first)")
-        if not backend.planar_base:
-            raise ValueError("the tour in simulation needs backend.planar_base=true (x, y, yaw base joints)")
-        self.backend = backend
-        model = backend.model
-        self._qadr = [model.joint(n).qposadr[0] for n in BASE_JOINTS]
-        self._dadr = [model.joint(n).dofadr[0] for n in BASE_JOINTS]
+        """`base`: the connected simulator's planar base (open the session first)."""
+        self.base = base
         self.velocity_std, self.yaw_rate_std = velocity_std, yaw_rate_std
         self.rest_speed = rest_speed
         self._rng = np.random.default_rng(seed)
@@ -39,26 +32,16 @@ class MujocoBase:
 
     # -- ground truth ------------------------------------------------------------------------
     def true_pose(self) -> Pose2D:
-        x, y, yaw = (float(self.backend.data.qpos[a]) for a in self._qadr)
+        x, y, yaw = self.base.pose()
         return Pose2D(x, y, wrap_angle(yaw))
 
     def true_velocity(self) -> tuple[float, float, float]:
         """Body-frame (vx, vy, wz) of the simulated base."""
-        vx_w, vy_w, wz = (float(self.backend.data.qvel[a]) for a in self._dadr)
-        yaw = float(self.backend.data.qpos[self._qadr[2]])
-        c, s = math.cos(yaw), math.sin(yaw)
-        return c * vx_w + s * vy_w, -s * vx_w + c * vy_w, wz
+        return self.base.velocity()
 
     def place(self, pose: Pose2D) -> None:
         """Teleport the base (at rest) and reset odometry to it: the start of a tour or a trial."""
-        import mujoco
-
-        data = self.backend.data
-        for adr, value in zip(self._qadr, (pose.x, pose.y, pose.yaw)):
-            data.qpos[adr] = value
-        for adr in self._dadr:
-            data.qvel[adr] = 0.0
-        mujoco.mj_forward(self.backend.model, data)
+        self.base.place(pose.x, pose.y, pose.yaw)
         self._odom = pose
         self._commanded, self._settled = False, True
 
@@ -67,11 +50,11 @@ class MujocoBase:
         return self._odom
 
     def command(self, vx: float, wz: float) -> None:
-        self.backend.set_base_velocity(float(vx), 0.0, float(wz))
+        self.base.set_velocity(float(vx), 0.0, float(wz))
         self._commanded, self._settled = (vx, wz) != (0.0, 0.0), False
 
     def stop(self) -> None:
-        self.backend.set_base_velocity(0.0, 0.0, 0.0)
+        self.base.set_velocity(0.0, 0.0, 0.0)
         self._commanded, self._settled = False, False
 
     def moving(self) -> bool:

@@ -8,9 +8,9 @@ and drops shadows and floor reflections, which cost most of a software-rendered 
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
+from emopose.backends.capabilities import SimulatedState
 from emopose.tour.scenario import TourSpec
 
 OVERVIEW_CAMERA = "tour_overview"
@@ -59,14 +59,13 @@ def write_scene(spec: TourSpec, path: str | Path, model_path: str | Path | None 
 
 def install_scene(backend, spec: TourSpec, run_dir: Path, video: bool = True) -> None:
     """Point a not-yet-connected MuJoCo backend at the tour scene (and the video into run_dir)."""
-    if getattr(backend, "name", "") != "mujoco":
+    if not isinstance(backend, SimulatedState):
         return
     if backend.data is not None:
-        raise RuntimeError("install_scene must run before the backend connects (before ctx.open())")
+        raise RuntimeError("install_scene must run before the backend connects (before session.open())")
     # mujoco reads MUJOCO_GL at its first import, which is about to happen here rather than in
     # connect(): choose the GL platform the way the backend would.
-    viewer = backend.viewer and bool(os.environ.get("DISPLAY"))
-    os.environ.setdefault("MUJOCO_GL", "glfw" if viewer else "egl")
+    backend.select_gl()
     backend.model_path = str(write_scene(spec, run_dir / "tour_scene.xml", backend.model_path))
-    if video and backend.video_path is None:
-        backend.video_path = str(run_dir / "tour.mp4")
+    if video and backend.renderer.video_path is None:
+        backend.renderer.video_path = str(run_dir / "tour.mp4")

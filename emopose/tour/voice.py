@@ -1,22 +1,26 @@
 """Saying things on the tour: plan a line into gestures, speak it, and wait for it to finish.
 
-perform() is ctx.run_turn's flow without its blocking dispatch: the tour pipeline (conf/pipeline/
-tour.yaml) queues the gestures against the speech start and returns, and finish() then advances the
-world until the speech has ended and the arms have settled, polling for a visitor's question, which
-cuts the line short. speak_only() is speech without gestures (lines said while walking).
+perform() runs the line as a turn through the turn runner; the tour pipeline (conf/pipeline/tour.yaml)
+dispatches without blocking, so it returns once the gestures are queued against the speech start, and
+finish() then advances the world until the speech has ended and the arms have settled, polling for a
+visitor's question, which cuts the line short. speak_only() is speech without gestures (lines said
+while walking).
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
-from emopose.pipeline import Turn
-from emopose.sequencer import State
-from emopose.speech.clip import SpeechClip
+from emopose.planners.base import Planner
+from emopose.runner import TurnRunner
+from emopose.sequencer import Sequencer, State
+from emopose.speech.clip import SpeechClip, Synthesizer
+from emopose.speech.player import Player
 from emopose.tour.interruptions import Question
 from emopose.tour.world import TourWorld
+from emopose.turn import Turn
 
 _SENTENCE_END = re.compile(r"[.!?]+[\"')\]]*\s+")
 # The parse stage keeps at most 200 characters of a model's reply (stages/parse.py, _text), so a
@@ -71,37 +75,29 @@ def _char_at(speech: SpeechClip, t: float) -> int:
 
 
 class TourVoice:
-    def __init__(self, world: TourWorld) -> None:
-        self.world, self.ctx = world, world.ctx
+    def __init__(self, world: TourWorld, turns: TurnRunner, synthesizer: Synthesizer, player: Player,
+                 sequencer: Sequencer) -> None:
+        self.world, self.turns = world, turns
+        self.synthesizer, self.player, self.sequencer = synthesizer, player, sequencer
 
-    def perform(self, utterance: str, kind: str, image: bytes | None = None, planner=None,
+    def perform(self, utterance: str, kind: str, image: bytes | None = None, planner: Planner | None = None,
                 extra_history: tuple[dict, ...] = ()) -> Line:
         """Plan `utterance` (with the dialogue so far) and start saying it with its gestures."""
-        ctx = self.ctx
-        turn = ctx.new_turn(utterance, image)
-        if extra_history:
-            turn.request = replace(turn.request, history=turn.request.history + extra_history)
-        if planner is None:
-            ctx.plan_turn(turn)
-        else:
-            turn.planner_output = planner.plan(turn.request)
-            turn.stage_s["planner"] = turn.planner_output.latency_s
-        ctx.pipeline.run(turn, ctx)
-        ctx.record_turn(turn)
-        submitted = turn.values.get("submitted")
-        start = submitted.speech_start if submitted is not None else ctx.clock.now()
-        return Line(kind, turn.plan.reply, turn.schedule.speech, start, turn)
+        # The tour writes the dialogue itself once a line has been said: a narration line is the robot's
+        # own (no visitor said it), and a line cut short counts only as far as it was spoken.
+        turn = self.turns.run(utterance, image, extra_history=extra_history, planner=planner, remember=False)
+        return Line(kind, turn.plan.reply, turn.speech, turn.dispatched.speech_start, turn)
 
     def speak_only(self, text: str, kind: str) -> Line:
-        speech = self.ctx.speech.synthesize(text)
-        start = self.ctx.start_speech(speech)
+        speech = self.synthesizer.synthesize(text)
+        start = self.player.play(speech, self.world.clock)
         self.world.record("/tour/speech", {"kind": kind, "text": text, "duration_s": speech.duration_s})
         return Line(kind, text, speech, start)
 
     def finish(self, line: Line, poll: Callable[[float], Question | None] | None = None,
                wait_for_gestures: bool = True, timeout_s: float = 120.0) -> Question | None:
         """Advance until the line is spoken (and its gestures done); a polled question stops it early."""
-        sequencer, end = self.ctx.sequencer, line.speech_start + line.speech.duration_s
+        sequencer, end = self.sequencer, line.speech_start + line.speech.duration_s
         deadline = self.world.now() + timeout_s
         while self.world.now() < deadline:
             now = self.world.now()
@@ -117,14 +113,12 @@ class TourVoice:
 
     def cut_short(self) -> None:
         """Stop talking and clear pending gestures, blending from the current pose toward neutral."""
-        player = self.ctx.player
-        if player is not None and hasattr(player, "stop"):
-            player.stop()
-        self.ctx.sequencer.interrupt([], now=self.world.now())
+        self.player.stop()
+        self.sequencer.interrupt([], now=self.world.now())
 
     def to_rest(self, timeout_s: float = 5.0) -> bool:
         """Bring the arms back to neutral now (skipping the hold) and wait until they are there."""
-        sequencer = self.ctx.sequencer
+        sequencer = self.sequencer
         if sequencer.state == State.HOLDING and sequencer.settled():
             sequencer.interrupt([], now=self.world.now())
         return self.world.run_until(lambda: sequencer.state == State.IDLE and sequencer.settled(), timeout_s)

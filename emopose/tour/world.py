@@ -11,19 +11,21 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from emopose.clock import Clock
+from emopose.session import Session
 from emopose.tour.navigator import MobileBase
 
 
 class TourWorld:
-    def __init__(self, ctx, base: MobileBase, record_hz: float = 10.0) -> None:
-        self.ctx, self.base = ctx, base
-        self.loop = ctx.open()
+    def __init__(self, session: Session, clock: Clock, base: MobileBase, record_hz: float = 10.0) -> None:
+        self.session, self.clock, self.base = session, clock, base
+        self.loop = session.open()
         self.dt = self.loop.dt
         self._record_every = max(1, round(1.0 / (record_hz * self.dt)))
         self._ticks = 0
 
     def now(self) -> float:
-        return self.ctx.clock.now()
+        return self.clock.now()
 
     @property
     def stream_time(self) -> float:
@@ -31,7 +33,7 @@ class TourWorld:
 
     def advance(self) -> None:
         if self.loop.running:
-            self.ctx.clock.sleep_until(self.ctx.clock.now() + self.dt)
+            self.clock.sleep_until(self.clock.now() + self.dt)
             if self.loop.error is not None:
                 raise RuntimeError("control loop failed") from self.loop.error
         else:
@@ -49,14 +51,8 @@ class TourWorld:
             self.advance()
         return True
 
-    def run_for(self, seconds: float) -> None:
-        end = self.now() + seconds
-        while self.now() < end:
-            self.advance()
-
     def record(self, topic: str, payload: dict) -> None:
-        if self.ctx.recorder is not None:
-            self.ctx.recorder.write(topic, self.stream_time, payload)
+        self.session.write(topic, payload)
 
     def record_base(self) -> None:
         self.record("/base/odometry", self.base.odometry().as_dict())

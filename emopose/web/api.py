@@ -40,7 +40,7 @@ def info(request: Request) -> dict:
 
 @router.get("/status")
 def status(request: Request) -> dict:
-    return session_of(request).status(events_from=max(0, len(session_of(request).ctx.sequencer.events) - 20))
+    return session_of(request).status(events_from=max(0, len(session_of(request).res.sequencer.events) - 20))
 
 
 @router.get("/turns")
@@ -65,9 +65,9 @@ async def gesture(body: GestureRequest, request: Request) -> dict:
 @router.post("/resolve")
 def resolve(body: ResolveRequest, request: Request) -> dict:
     """The resolver on the live library, without executing: which entry a record would run."""
-    library = session_of(request).ctx.library
+    library = session_of(request).res.library
     resolved = resolve_record(GestureRecord(cls=body.cls, variant=body.variant), library)
-    return {**resolved.audit(), "library_version": library.version}
+    return {**resolved.as_json(), "library_version": library.version}
 
 
 @router.post("/interrupt")
@@ -87,7 +87,7 @@ def audio(turn_id: int, request: Request) -> FileResponse:
 async def utterance_audio(request: Request) -> dict:
     """Microphone input: transcribe with the configured ASR, then run the turn."""
     session = session_of(request)
-    if not session.info()["asr"]:
+    if not session.hears_speech:
         raise HTTPException(409, "no speech recognition configured; type the utterance (or run with asr=litellm)")
     media = request.headers.get("content-type", "").split(";")[0].strip().lower()
     if media not in AUDIO_TYPES:

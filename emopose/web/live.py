@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import logging
 
+from emopose.backends.capabilities import SimulatedState
+from emopose.resources import Run
 from emopose.web.frames import Channel, FramePump, Webcam
 from emopose.web.pose_renderer import PoseRenderer
 from emopose.web.session import LiveSession
@@ -18,18 +20,20 @@ from emopose.web.settings import ServeSettings
 log = logging.getLogger(__name__)
 
 
-def open_session(ctx, settings: ServeSettings, render: bool = True) -> LiveSession:
+def open_session(run: Run, settings: ServeSettings, render: bool = True) -> LiveSession:
     """Build the session's image sources; `render=False` skips MuJoCo entirely (fast API tests)."""
     renderer = None
     if render:
-        backend = ctx.backend
-        renderer = PoseRenderer(getattr(backend, "model_path", None), getattr(backend, "planar_base", False),
+        backend = run.resources.backend
+        model_path, planar = ((backend.model_path, backend.planar_base is not None)
+                              if isinstance(backend, SimulatedState) else (None, False))
+        renderer = PoseRenderer(model_path, planar,
                                 settings.render_width, settings.render_height, settings.render_quality)
         renderer.start()
-    session = LiveSession(ctx, settings, renderer=renderer)
+    session = LiveSession(run, settings, renderer=renderer)
     channels = []
     rendering = renderer is not None and renderer.available
-    if rendering and ctx.backend.name == "mujoco":
+    if rendering and isinstance(run.resources.backend, SimulatedState):
         channels.append(Channel("sim", settings.sim_fps, _renderer_view(session, settings.sim_camera),
                                 f"MuJoCo '{settings.sim_camera}' camera"))
     camera = _camera_channel(session, settings, rendering)

@@ -84,7 +84,8 @@ class PoseRenderer:
         os.environ.setdefault("MUJOCO_GL", "egl")
         import mujoco
 
-        from emopose.robot.model import JOINT_NAMES, build_model
+        from emopose.robot.g1_spec import JOINT_NAMES
+        from emopose.robot.model import build_model
         from emopose.robot.render import OffscreenRenderer
 
         model = build_model(self.model_path, planar_base=self.planar_base)

@@ -35,7 +35,7 @@ def _round(a: np.ndarray) -> list:
 
 @router.get("/library")
 def library_index(request: Request) -> dict:
-    library = session_of(request).ctx.library
+    library = session_of(request).res.library
     snapshot, limits = library.snapshot, library.limits
     entries = [{"name": e.name, "class": e.cls, "description": e.description, "motion_type": e.motion_type,
                 "keyframes": len(e.keyframes), "duration": e.default_duration,
@@ -48,7 +48,7 @@ def library_index(request: Request) -> dict:
 
 @router.get("/library/{name}")
 def library_entry(request: Request, name: str = Path(pattern=NAME_PATTERN)) -> dict:
-    entry = session_of(request).ctx.library.get(name)
+    entry = session_of(request).res.library.get(name)
     if entry is None:
         raise HTTPException(404, f"no motion named {name!r}")
     return entry.model_dump(mode="json", by_alias=True)

@@ -7,13 +7,13 @@ released, following the audio clock when the reply's WAV plays.
 
 from __future__ import annotations
 
-from emopose.pipeline import Turn
 from emopose.stages.schedule import trigger_position
+from emopose.turn import Turn
 
 
 def cue_rows(turn: Turn) -> list[dict]:
     reply = turn.plan.reply
-    schedule = turn.values.get("schedule")
+    schedule = turn.schedule
     releases = schedule.releases if schedule is not None else [None] * len(turn.resolved)
     rows = []
     for k, (resolved, release) in enumerate(zip(turn.resolved, releases)):
@@ -32,15 +32,13 @@ def cue_rows(turn: Turn) -> list[dict]:
 
 def summarize_turn(turn: Turn, turn_id: int, kind: str, audio_url: str | None, library_version: int) -> dict:
     plan = turn.plan
-    schedule = turn.values.get("schedule")
-    submitted = turn.values.get("submitted")
-    output = turn.planner_output
+    speech, submitted, output = turn.speech, turn.submitted, turn.planner_output
     return {
         "type": "turn", "turn_id": turn_id, "kind": kind,
         "utterance": turn.request.utterance, "reply": plan.reply, "source": plan.source,
         "notes": list(plan.notes), "cues": cue_rows(turn),
-        "speech": {"duration_s": schedule.speech.duration_s if schedule else 0.0,
-                   "estimated": schedule.speech.estimated if schedule else True, "audio": audio_url},
+        "speech": {"duration_s": speech.duration_s if speech else 0.0,
+                   "estimated": speech.estimated if speech else True, "audio": audio_url},
         "speech_start": submitted.speech_start if submitted else None,
         "planner_latency_s": output.latency_s if output else 0.0,
         "planner_error": output.error if output else None,

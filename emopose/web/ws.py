@@ -97,7 +97,7 @@ async def _send_quietly(websocket: WebSocket, message: dict) -> None:
 async def _send_loop(websocket: WebSocket, session: LiveSession) -> None:
     settings = session.settings
     last_id = max((m["id"] for m in session.log_since(0)), default=0)
-    events_from = len(session.ctx.sequencer.events)
+    events_from = len(session.res.sequencer.events)
     frames_seen: dict[str, int] = {}
     period = 1.0 / max(settings.state_hz, settings.sim_fps)
     state_every, tick = max(1, round(max(settings.state_hz, settings.sim_fps) / settings.state_hz)), 0
@@ -105,7 +105,7 @@ async def _send_loop(websocket: WebSocket, session: LiveSession) -> None:
         while True:
             for message in session.log_since(last_id):
                 last_id = message["id"]
-                await websocket.send_text(json.dumps({**message, "now": session.ctx.clock.now()}))
+                await websocket.send_text(json.dumps({**message, "now": session.res.clock.now()}))
             if tick % state_every == 0:
                 state = session.status(events_from)
                 events_from = state.pop("events_next")

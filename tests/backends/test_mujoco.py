@@ -9,11 +9,12 @@ os.environ.setdefault("MUJOCO_GL", "egl")  # must precede the first mujoco impor
 import numpy as np
 import pytest
 
-from emopose import CONTROL_DT
 from emopose.backends.base import Backend
 from emopose.backends.mujoco import MujocoBackend
 from emopose.recording import Recorder, read_recording
-from emopose.robot.model import JOINT_NAMES, build_model
+from emopose.robot.g1_spec import CONTROL_DT, JOINT_NAMES
+from emopose.robot.model import build_model
+from tests.backends.mujoco_run import NEUTRAL, run_ticks
 
 # g1.md, left arm: body -> (pos, quat wxyz, range, torque limit, mass, COM).
 LEFT_ARM = {
@@ -77,7 +78,6 @@ LEFT_ARM = {
 RIGHT_SHOULDER_PITCH_Y = -0.10021  # g1.md lists the right shoulder's y separately
 HELD_POSE = np.array([-0.5, 0.2, 0, 1.0, 0, 0, 0, -0.5, -0.2, 0, 1.0, 0, 0, 0])
 SINE_CENTER = np.array([-0.4, 0.45, 0, 0.9, 0, 0, 0, -0.4, -0.45, 0, 0.9, 0, 0, 0])
-NEUTRAL = np.array([0, 0.15, 0, 1.2, 0, 0, 0, 0, -0.15, 0, 1.2, 0, 0, 0])
 # Left shoulder pitched forward, upper arm yawed inward, forearm raised: the hand meets the chest.
 HAND_ON_CHEST = np.concatenate([[-0.6, 0.0, -1.2, -0.5, 0, 0, 0], NEUTRAL[7:]])
 
@@ -90,14 +90,6 @@ def _expected(side: str, link: str):
         com = (com[0], -com[1], com[2])
         rng = (-rng[1], -rng[0]) if link == "shoulder_roll" else rng
     return pos, quat, rng, limit, mass, com
-
-
-def _run(backend: MujocoBackend, targets: np.ndarray) -> np.ndarray:
-    measured = []
-    for k, q in enumerate(targets):
-        backend.send(k * CONTROL_DT, q)
-        measured.append(backend.measured())
-    return np.array(measured)
 
 
 @pytest.fixture
@@ -151,7 +143,7 @@ def test_backend_protocol_and_zero_pose_geometry(backend):
 
 def test_holds_pose_with_gravity_compensation_within_torque_limits(backend):
     backend.connect(None)
-    measured = _run(backend, np.tile(HELD_POSE, (100, 1)))  # 2 s
+    measured = run_ticks(backend, np.tile(HELD_POSE, (100, 1)))  # 2 s
     assert np.max(np.abs(measured[-1] - HELD_POSE)) < 0.01
     assert backend.max_actuator_force_ratio <= 1.0 + 1e-9
     m, d = backend.model, backend.data
@@ -166,7 +158,7 @@ def test_tracks_sinusoid_at_50hz():
     t = np.arange(0, 4, CONTROL_DT)
     phase = np.linspace(0, 2 * np.pi, 14, endpoint=False)
     targets = SINE_CENTER + 0.3 * np.sin(2 * np.pi * 0.5 * t[:, None] + phase)
-    measured = _run(backend, targets)
+    measured = run_ticks(backend, targets)
     after = t >= 0.5
     mae = np.mean(np.abs(measured[after] - targets[after]))
     backend.close()
@@ -177,7 +169,7 @@ def test_tracks_sinusoid_at_50hz():
 def test_hand_pushed_into_torso_is_a_self_contact(backend):
     backend.connect(None)
     ramp = np.linspace(NEUTRAL, HAND_ON_CHEST, 50)
-    _run(backend, np.vstack([ramp, np.tile(HAND_ON_CHEST, (25, 1))]))
+    run_ticks(backend, np.vstack([ramp, np.tile(HAND_ON_CHEST, (25, 1))]))
     contacts = backend.contacts()
     assert any("left_hand" in pair and {"chest", "abdomen"} & set(pair) for pair in contacts), (
         contacts
@@ -188,47 +180,9 @@ def test_hand_pushed_into_torso_is_a_self_contact(backend):
 def test_records_sim_and_torque_streams(tmp_path, backend):
     with Recorder(tmp_path / "run.mcap") as recorder:
         backend.connect(recorder)
-        _run(backend, np.tile(HELD_POSE, (5, 1)))
+        run_ticks(backend, np.tile(HELD_POSE, (5, 1)))
     streams = read_recording(tmp_path / "run.mcap")
     assert len(streams["/joints/sim"]) == len(streams["/joints/torque"]) == 5
     assert "/joints/command" not in streams  # the control loop records the commanded stream, once
     assert streams["/joints/sim"][0][1]["t"] == pytest.approx(CONTROL_DT)  # state at end of period
     assert len(streams["/joints/torque"][0][1]["tau"]) == 14
-
-
-def test_planar_base_drives_forward():
-    backend = MujocoBackend(planar_base=True)
-    backend.connect(None)
-    backend.set_base_velocity(0.3, 0.0, 0.0)
-    _run(backend, np.zeros((50, 14)))
-    x = backend.data.body("pelvis").xpos
-    backend.close()
-    assert 0.25 < x[0] < 0.31 and abs(x[1]) < 0.01
-
-
-def _egl_skip_reason() -> str | None:
-    try:
-        import mujoco
-
-        renderer = mujoco.Renderer(mujoco.MjModel.from_xml_string("<mujoco/>"), 8, 8)
-        renderer.close()
-    except Exception as exc:  # noqa: BLE001 -- no GPU/EGL driver, or MUJOCO_GL set to something unusable here
-        return f"offscreen rendering unavailable (MUJOCO_GL={os.environ.get('MUJOCO_GL')}): {exc}"
-    return None
-
-
-def test_renders_nonblank_frame_and_video(tmp_path):
-    if reason := _egl_skip_reason():
-        pytest.skip(reason)
-    backend = MujocoBackend(
-        width=320, height=240, video_path=str(tmp_path / "sim.mp4"), render_every=1
-    )
-    backend.connect(None)
-    _run(backend, np.tile(NEUTRAL, (5, 1)))
-    for camera in ("front", "head"):
-        frame = backend.render_frame(camera)
-        assert frame.shape == (240, 320, 3) and frame.dtype == np.uint8
-        assert frame.std() > 10  # not a flat fill
-    assert backend.last_frame is not None
-    backend.close()
-    assert (tmp_path / "sim.mp4").stat().st_size > 1000

@@ -40,9 +40,9 @@ def _turn(reply, triggers):
 @pytest.mark.parametrize("mode", ["anchor", "words"])
 def test_missing_triggers_are_flagged_and_logged(espeak, mode, caplog):
     reply = "Welcome to the lab. The robot arm is over there."
-    ctx = SimpleNamespace(speech=espeak)
     with caplog.at_level(logging.WARNING, logger="emopose.stages.schedule"):
-        schedule = ScheduleStage(mode=mode)(_turn(reply, ["Welcome", "under the table", "over there"]), ctx)
+        speech, schedule = ScheduleStage(espeak, mode=mode)(_turn(reply, ["Welcome", "under the table", "over there"]))
+    assert speech.text == reply and speech.words
     assert schedule.missing_triggers == [1]
     assert [r.how for r in schedule.releases][1] == "interpolated"
     assert "under the table" in caplog.text and "say-do" in caplog.text

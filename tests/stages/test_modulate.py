@@ -41,7 +41,7 @@ def test_duration_invariant(library):
     from emopose.stages.modulate import Modulate
     from emopose.stages.resolve import resolve_record
 
-    stage = Modulate()
+    stage = Modulate(library.limits)
     durations = {stage.modulate(resolve_record(GestureRecord(cls="agreeing", variant="agreeing_a", intensity=i),
-                                               library), library.limits).duration for i in range(1, 6)}
+                                               library)).duration for i in range(1, 6)}
     assert durations == {library.get("agreeing_a").default_duration}

@@ -5,7 +5,7 @@ from emopose.stages.resolve import Resolve, resolve_record
 def test_exact_name_is_global_lookup(library):
     resolved = resolve_record(GestureRecord(cls="agreeing", variant="pointing_b"), library)
     assert resolved.rule == "exact" and resolved.entry.name == "pointing_b" and not resolved.class_agrees
-    assert resolved.audit()["requested"] == "pointing_b"
+    assert resolved.as_json()["requested"] == "pointing_b"
 
 
 def test_missing_name_falls_back_to_class_default(library):
@@ -28,7 +28,7 @@ def test_empty_class_falls_back_to_neutral(tmp_path):
 
 def test_confidence_gating_off_by_default_and_on_when_set(library):
     record = GestureRecord(cls="rejecting", variant="rejecting_b", confidence=0.2)
-    assert Resolve().resolve(record, library).entry.name == "rejecting_b"
-    gated = Resolve(min_confidence=0.5).resolve(record, library)
+    assert Resolve(library).resolve(record).entry.name == "rejecting_b"
+    gated = Resolve(library, min_confidence=0.5).resolve(record)
     assert gated.rule == "gated" and gated.entry.name == "rejecting_a"
-    assert Resolve(min_confidence=0.5, gate_to="neutral").resolve(record, library).entry.name == "neutral_rest"
+    assert Resolve(library, min_confidence=0.5, gate_to="neutral").resolve(record).entry.name == "neutral_rest"

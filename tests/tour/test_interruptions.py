@@ -48,10 +48,10 @@ class InterruptSpy:
 def test_a_question_during_narration_clears_answers_and_resumes(tmp_path):
     raw = small(interruptions=[{"at_stop": "first", "after_s": 2.5, "text": "Who made that box?",
                                 "answer": "Our students made it. Look at it over there!"}])
-    with tour_runner(tmp_path, raw) as runner:
-        spy = InterruptSpy(runner.ctx.sequencer)
-        report = runner.run()
-        history = list(runner.ctx.history)
+    with tour_runner(tmp_path, raw) as (run, tour):
+        spy = InterruptSpy(run.resources.sequencer)
+        report = tour.run()
+        history = list(run.runner.history)
     cut = next(c for c in spy.calls if c["now"] is not None)
     assert cut["pending"] + cut["active"] >= 1  # gestures were queued or running ...
     assert cut["commands"] == 0 and cut["state_after"] == "blending"  # ... and were cleared with a blend
@@ -73,16 +73,16 @@ def test_a_question_during_narration_clears_answers_and_resumes(tmp_path):
 def test_a_question_while_walking_stops_the_base_first_then_the_leg_resumes(tmp_path):
     raw = small(interruptions=[{"during_leg": "second", "after_s": 1.5, "text": "How fast can you walk?",
                                 "answer": "Indoors I walk slowly, for safety."}])
-    with tour_runner(tmp_path, raw) as runner:
+    with tour_runner(tmp_path, raw) as (run, tour):
         speeds = []
-        answer = runner.answer
+        answer = tour.answer
 
         def spying_answer(question):
-            speeds.append(runner.base.true_velocity())
+            speeds.append(tour.base.true_velocity())
             return answer(question)
 
-        runner.answer = spying_answer
-        report = runner.run()
+        tour.answer = spying_answer
+        report = tour.run()
     assert speeds and all(abs(v) < 0.02 for v in speeds[0])  # at rest before answering
     exchange = report.exchanges[0]
     assert exchange.base_moving_when_asked and exchange.where == "leg:second"
@@ -95,11 +95,11 @@ def test_a_question_while_walking_stops_the_base_first_then_the_leg_resumes(tmp_
 def test_stop_the_tour_aborts_and_leaves_the_robot_at_rest(tmp_path):
     raw = small(interruptions=[{"at_stop": "first", "after_s": 3.0, "text": "Sorry, please stop the tour now."},
                                {"at_stop": "second", "text": "Never asked"}])
-    with tour_runner(tmp_path, raw) as runner:
-        report = runner.run()
-        neutral = runner.ctx.library.neutral_entry.q[0]
-        measured = runner.ctx.backend.measured()
-        moving = runner.base.moving()
+    with tour_runner(tmp_path, raw) as (run, tour):
+        report = tour.run()
+        neutral = run.resources.library.neutral_entry.q[0]
+        measured = run.resources.backend.measured()
+        moving = tour.base.moving()
     assert report.aborted and len(report.stops) == 1 and report.exchanges[0].aborted
     assert report.exchanges[0].answer.startswith("Of course, we will end the tour")
     assert report.unasked == ["Never asked"]
@@ -110,8 +110,8 @@ def test_stop_the_tour_aborts_and_leaves_the_robot_at_rest(tmp_path):
 @pytest.mark.parametrize("gesture_while_walking", [False, True])
 def test_lines_said_while_walking_gesture_only_when_allowed(tmp_path, gesture_while_walking):
     raw = small(gesture_while_walking=gesture_while_walking)  # stop 2 has an approach line with cues
-    with tour_runner(tmp_path, raw) as runner:
-        report = runner.run()
+    with tour_runner(tmp_path, raw) as (run, tour):
+        report = tour.run()
     walking = report.stops[1].gestures_while_walking
     assert (walking > 0) == gesture_while_walking
     assert all(s.within_tolerance for s in report.stops)
@@ -135,10 +135,10 @@ class FailingPlanner:
 def test_a_failure_mid_tour_still_ends_with_the_base_stopped_and_arms_at_neutral(tmp_path):
     raw = small(stops=[dict(small()["stops"][0], narration="Hello and welcome! Look at the box over there. "
                             "It is really important. " * 4)])
-    with tour_runner(tmp_path, raw) as runner:
-        runner.ctx.planner = FailingPlanner(runner.ctx.planner)
+    with tour_runner(tmp_path, raw) as (run, tour):
+        run.runner.planner = FailingPlanner(run.runner.planner)
         with pytest.raises(RuntimeError, match="planner crashed"):
-            runner.run()
-        neutral = runner.ctx.library.neutral_entry.q[0]
-        assert runner.report.ended_at_rest and not runner.base.moving()
-        assert np.max(np.abs(runner.ctx.backend.measured() - neutral)) < 0.02
+            tour.run()
+        neutral = run.resources.library.neutral_entry.q[0]
+        assert tour.report.ended_at_rest and not tour.base.moving()
+        assert np.max(np.abs(run.resources.backend.measured() - neutral)) < 0.02

@@ -11,6 +11,7 @@ import pytest
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 from emopose.backends.mujoco import MujocoBackend
+from emopose.backends.planar_base import MujocoPlanarBase
 from emopose.tour.controller import GoToPose
 from emopose.tour.g1_base import G1Base
 from emopose.tour.geometry import Pose2D, wrap_angle
@@ -51,9 +52,9 @@ def test_controller_at_the_goal_only_turns_and_refuses_fast_settings():
 
 
 def sim_navigator(velocity_std=0.0, yaw_rate_std=0.0, seed=0):
-    backend = MujocoBackend(planar_base=True)
+    backend = MujocoBackend(planar_base=MujocoPlanarBase())
     q0 = backend.connect(None)
-    base = MujocoBase(backend, velocity_std, yaw_rate_std, seed)
+    base = MujocoBase(backend.planar_base, velocity_std, yaw_rate_std, seed)
     clock = [0.0]
 
     def advance():
@@ -77,9 +78,9 @@ def test_mujoco_base_reaches_the_four_lab_stops():
 
 
 def test_walking_is_a_command_in_force_not_the_sway_of_gesturing_arms():
-    backend = MujocoBackend(planar_base=True)
+    backend = MujocoBackend(planar_base=MujocoPlanarBase())
     q0 = backend.connect(None)
-    base = MujocoBase(backend)
+    base = MujocoBase(backend.planar_base)
 
     def advance(periods: int = 1) -> None:
         for _ in range(periods):
@@ -170,6 +171,6 @@ def test_the_tour_job_says_which_backends_have_a_base():
 
     spec = load_tour(LAB_FILE)
     with pytest.raises(TourConfigError, match="backend=dry_run has none"):
-        TourJob().make_base(SimpleNamespace(backend=SimpleNamespace(name="dry_run")), spec)
+        TourJob().make_base(SimpleNamespace(name="dry_run"), spec)
     with pytest.raises(TourConfigError, match="job.g1_odometry"):
-        TourJob().make_base(SimpleNamespace(backend=SimpleNamespace(name="g1")), spec)
+        TourJob().make_base(SimpleNamespace(name="g1"), spec)

@@ -4,23 +4,21 @@ from __future__ import annotations
 
 import json
 import math
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from emopose.app import run
 from emopose.contract import GestureRecord, Plan
-from emopose.pipeline import Turn
 from emopose.planners.base import PlanRequest
 from emopose.robot.kinematics import mirror
-from emopose.stages.modulate import ModulatedGesture
 from emopose.stages.resolve import resolve_record
 from emopose.tour.aim import AimStage, active_side, peak_indices
 from emopose.tour.geometry import Pose2D
 from emopose.tour.pointing_ik import aim_arm, pointing_error
 from emopose.tour.scenario import parse_tour
-from emopose.tour.scene_view import SceneView
+from emopose.tour.scene_view import SceneSlot, SceneView
+from emopose.turn import ModulatedGesture, Turn
 from tests.tour.tour_helpers import compose_config, small, synthetic_library
 
 POINT_RIGHT = np.array([0.1, 0.12, 0, 1.2, 0, 0, 0, -1.4, -0.8, 0, 1.25, 0, 0.1, 0])
@@ -51,15 +49,13 @@ def pointing_gesture(library, trigger="over there") -> ModulatedGesture:
     return ModulatedGesture(resolved, resolved.entry.q.copy(), resolved.entry.default_duration)
 
 
-def fake_ctx(library, scene, safety=None):
-    return SimpleNamespace(library=library, scene=scene, sequencer=SimpleNamespace(safety=safety))
+def aim_stage(library, scene: SceneView | None, safety=None, **settings) -> AimStage:
+    return AimStage(SceneSlot(scene), library.limits, safety, **settings)
 
 
 def turn_with(gestures, reply="Look at the red box over there."):
-    turn = Turn(PlanRequest(reply))
-    turn.values["plan"] = Plan(reply=reply, records=tuple(g.resolved.record for g in gestures))
-    turn.values["modulated"] = list(gestures)
-    return turn
+    plan = Plan(reply=reply, records=tuple(g.resolved.record for g in gestures))
+    return Turn(PlanRequest(reply), plan=plan, modulated=list(gestures))
 
 
 def lab_scene(stop: int = 0) -> SceneView:
@@ -70,7 +66,7 @@ def lab_scene(stop: int = 0) -> SceneView:
 
 def test_aim_stage_replaces_only_the_peak_keyframes(library):
     gesture, scene = pointing_gesture(library), lab_scene(0)  # red box ahead-right: the right arm points
-    out = AimStage()(turn_with([gesture]), fake_ctx(library, scene))[0]
+    out = aim_stage(library, scene)(turn_with([gesture]))[0]
     original = gesture.keyframes
     assert active_side(original) == 1
     peaks = peak_indices(out.keyframes, 1, 0.6)
@@ -87,8 +83,7 @@ def test_aim_stage_replaces_only_the_peak_keyframes(library):
 
 def test_a_target_on_the_other_side_mirrors_the_gesture(library):
     scene = lab_scene(1)  # the blue ball is to the robot's left
-    out = AimStage()(turn_with([pointing_gesture(library, "the blue ball")], "See the blue ball."),
-                     fake_ctx(library, scene))[0]
+    out = aim_stage(library, scene)(turn_with([pointing_gesture(library, "the blue ball")], "See the blue ball."))[0]
     report = scene.aims[0]
     assert report.target == "blue_ball" and report.side == "left" and report.mirrored
     assert report.error_deg < 0.5 and active_side(out.keyframes) == 0
@@ -107,18 +102,16 @@ def test_target_lookup_by_trigger_sentence_or_the_stops_only_object():
 
 def test_nothing_is_aimed_without_a_scene_a_target_or_for_self_pointing(library):
     gesture = pointing_gesture(library)
-    ctx = fake_ctx(library, None)
-    assert AimStage()(turn_with([gesture]), ctx)[0] is gesture  # no tour: pass through
+    assert aim_stage(library, None)(turn_with([gesture]))[0] is gesture  # no tour: pass through
     scene = SceneView.walking(Pose2D(0, 0, 0), [])
-    assert AimStage()(turn_with([gesture]), fake_ctx(library, scene))[0] is gesture  # no known target
-    scene = lab_scene(0)
-    assert AimStage(skip=("pointing_a",))(turn_with([gesture]), fake_ctx(library, scene))[0] is gesture
+    assert aim_stage(library, scene)(turn_with([gesture]))[0] is gesture  # no known target
+    assert aim_stage(library, lab_scene(0), skip=("pointing_a",))(turn_with([gesture]))[0] is gesture
 
 
 def test_an_aimed_motion_that_collides_keeps_the_library_motion(library):
     scene = lab_scene(0)
     gesture = pointing_gesture(library)
-    out = AimStage()(turn_with([gesture]), fake_ctx(library, scene, safety=lambda s: "hand hits head"))[0]
+    out = aim_stage(library, scene, safety=lambda s: "hand hits head")(turn_with([gesture]))[0]
     assert out is gesture
     assert scene.aims[0].applied is False and scene.aims[0].reason == "hand hits head"
 
@@ -130,7 +123,7 @@ def test_a_colliding_aim_is_retried_with_the_arm_further_out(library):
         calls.append(samples)
         return "upper arm vs torso" if len(calls) == 1 else None
 
-    out = AimStage()(turn_with([pointing_gesture(library)]), fake_ctx(library, scene, brushes_the_torso_once))[0]
+    out = aim_stage(library, scene, brushes_the_torso_once)(turn_with([pointing_gesture(library)]))[0]
     assert len(calls) == 2 and scene.aims[0].applied and scene.aims[0].error_deg < 0.5
     peak = peak_indices(out.keyframes, 1, 0.6)[0]
     first_try = calls[0][8 * peak]  # the densified path passes through each keyframe every 8 samples

@@ -11,7 +11,7 @@ import yaml
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before the first mujoco import
 
-from emopose.build import build_context
+from emopose.build import build_run
 from emopose.config import CONFIG_DIR
 from emopose.tour.camera import camera_for
 from emopose.tour.runner import TourRunner
@@ -56,16 +56,12 @@ def tour_config(tmp_path: Path, *overrides: str):
 
 
 @contextmanager
-def tour_runner(tmp_path: Path, raw: dict, *overrides: str, noise: bool = False, answer_planner=None):
-    """A TourRunner on a fresh simulated context (closed afterwards)."""
-    ctx = build_context(tour_config(tmp_path, *overrides), tmp_path)
-    try:
-        spec = parse_tour(raw, "test scenario")
-        install_scene(ctx.backend, spec, tmp_path, video=False)
-        ctx.open()
-        n = spec.odometry_noise
-        base = MujocoBase(ctx.backend, *(n.velocity_std, n.yaw_rate_std, n.seed) if noise else (0.0, 0.0, 0))
+def tour_runner(tmp_path: Path, raw: dict, *overrides: str):
+    """A fresh simulated run and a TourRunner in it, as (run, tour); the run is closed afterwards."""
+    with build_run(tour_config(tmp_path, *overrides), tmp_path) as run:
+        spec, backend = parse_tour(raw, "test scenario"), run.resources.backend
+        install_scene(backend, spec, tmp_path, video=False)
+        run.session.open()
+        base = MujocoBase(backend.planar_base)  # noiseless odometry
         base.place(spec.start.pose())
-        yield TourRunner(ctx, spec, base, camera_for(ctx.backend), answer_planner=answer_planner)
-    finally:
-        ctx.close()
+        yield run, TourRunner(run, spec, base, camera_for(backend))

@@ -1,4 +1,4 @@
-"""Fixtures for the web UI: a temporary copy of the shipped G1 library and a live served context.
+"""Fixtures for the web UI: a temporary copy of the shipped G1 library, a live served Run, a Chromium.
 
 Tests never write into library/g1: every config points library.paths / write_dir / limits at a copy.
 """
@@ -12,22 +12,26 @@ import socket
 from pathlib import Path
 
 import pytest
-from hydra import compose, initialize_config_dir
 from omegaconf import OmegaConf
 
-from emopose.config import CONFIG_DIR, PROJECT_ROOT
+from emopose.config import PROJECT_ROOT
+from tests.conftest import compose_config
 
 SHIPPED = PROJECT_ROOT / "library" / "g1"
 LOCAL = "http://127.0.0.1"
 
 
-@pytest.fixture
-def library_copy(tmp_path: Path) -> Path:
-    if not (SHIPPED / "neutral_rest.yaml").is_file():
-        pytest.skip("library/g1 is not authored yet")
-    target = tmp_path / "library" / "g1"
+def copy_library(root: Path) -> Path:
+    """library/g1 copied to root/library/g1 (without its backups)."""
+    assert (SHIPPED / "neutral_rest.yaml").is_file(), f"{SHIPPED} lacks neutral_rest.yaml: the shipped library broke"
+    target = root / "library" / "g1"
     shutil.copytree(SHIPPED, target, ignore=shutil.ignore_patterns(".backup"))
     return target
+
+
+@pytest.fixture
+def library_copy(tmp_path: Path) -> Path:
+    return copy_library(tmp_path)
 
 
 def library_overrides(folder: Path) -> list[str]:
@@ -36,13 +40,11 @@ def library_overrides(folder: Path) -> list[str]:
 
 @functools.lru_cache(maxsize=8)
 def _composed(overrides: tuple[str, ...]):
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        return compose("config", overrides=["+experiment=serve", "planner=keyword", "run.record=false",
-                                             *overrides])
+    return compose_config(["+experiment=serve", "planner=keyword", "run.record=false", *overrides])
 
 
 def compose_serve(folder: Path, *overrides: str):
-    """Composing takes about a second; compose once per override set and point the copy at `folder`."""
+    """Composing takes a while; compose once per override set and point the copy at `folder`."""
     cfg = copy.deepcopy(_composed(tuple(overrides)))
     OmegaConf.update(cfg, "library.paths", [str(folder)])
     OmegaConf.update(cfg, "library.write_dir", str(folder))
@@ -58,8 +60,9 @@ def free_port() -> int:
 
 @pytest.fixture
 def serve_app(library_copy, tmp_path):
-    """A factory: serve_app(*overrides) -> (app, session, ctx), live (control loop running), no MuJoCo."""
-    from emopose.build import build_context, build_job
+    """A factory: serve_app(*overrides) -> (app, session), built as ServeJob builds it from the composed
+    serve experiment, live (control loop running), without MuJoCo frames. The Run is `session.run`."""
+    from emopose.build import build_job, build_run
     from emopose.web.app import create_app
     from emopose.web.live import open_session
 
@@ -67,24 +70,32 @@ def serve_app(library_copy, tmp_path):
 
     def make(*overrides: str):
         cfg = compose_serve(library_copy, *overrides)
-        job = build_job(cfg)
-        ctx = build_context(cfg, tmp_path / f"run{len(opened)}")
-        session = open_session(ctx, job.settings, render=False)
-        ctx.open()
-        ctx.loop.start()
-        opened.append((session, ctx))
-        return create_app(session), session, ctx
+        settings = build_job(cfg).settings  # validated first, as the CLI does: a bad serve.* builds nothing
+        run = build_run(cfg, tmp_path / f"run{len(opened)}")
+        session = open_session(run, settings, render=False)
+        opened.append(session)
+        run.session.open().start()
+        return create_app(session), session
 
     yield make
-    for session, ctx in opened:
+    for session in opened:
         session.close()
-        ctx.close()
+        session.run.session.close()
 
 
 @pytest.fixture
 def client(serve_app):
     from fastapi.testclient import TestClient
 
-    app, _, _ = serve_app()
+    app, _ = serve_app()
     with TestClient(app, base_url=LOCAL) as test_client:
         yield test_client
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """Debian's Chromium under Playwright (the browser tests are marked slow)."""
+    from tests.web.browser import chromium
+
+    with chromium() as launched:
+        yield launched

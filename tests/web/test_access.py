@@ -39,7 +39,7 @@ def test_the_cli_refuses_to_start_on_0000_without_a_token(library_copy, tmp_path
 
 
 def test_token_is_checked_on_http_and_websocket(serve_app):
-    app, _, _ = serve_app("serve.host=0.0.0.0", f"serve.token={TOKEN}")
+    app, _ = serve_app("serve.host=0.0.0.0", f"serve.token={TOKEN}")
     with TestClient(app, base_url="http://robot.lan:8765") as client:
         assert client.get("/api/info").status_code == 401
         assert client.get("/").status_code == 401

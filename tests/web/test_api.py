@@ -122,7 +122,7 @@ def test_oversized_bodies_are_refused(client):
 
 
 def test_unexpected_errors_are_json_without_a_traceback(serve_app, monkeypatch):
-    app, session, _ = serve_app()
+    app, session = serve_app()
 
     def broken(*args, **kwargs):
         raise RuntimeError("secret internals")
@@ -158,7 +158,7 @@ def test_a_symlink_out_of_the_library_is_never_written(client, library_copy, tmp
     (outside / "sneaky.yaml").write_text((library_copy / "face_wave.yaml").read_text().replace(
         "name: face_wave", "name: sneaky"))
     (library_copy / "sneaky.yaml").symlink_to(outside / "sneaky.yaml")
-    client.app.state.session.ctx.library.reload()
+    client.app.state.session.res.library.reload()
     before = (outside / "sneaky.yaml").read_text()
     response = client.post("/api/library", json=motion_body(client, "sneaky", overwrite=True))
     assert response.status_code == 403 and "outside the library" in response.json()["error"]

@@ -1,32 +1,21 @@
 """The web UI in a real headless Chromium (Debian's), driven by Playwright, against the real server.
 
-The server is the real CLI (python -m emopose +experiment=serve) in a subprocess on a free port,
-with the keyword planner and a temporary copy of library/g1; backend dry_run always, and mujoco
+The server is the real CLI on a free port (tests/web/browser.py); backend dry_run always, and mujoco
 when offscreen EGL rendering works here. Screenshots go to /tmp/web_check/ for a human look.
 """
 
 from __future__ import annotations
 
-import json
 import os
-import signal
 import subprocess
 import sys
-import time
-import urllib.request
-from pathlib import Path
 
 import pytest
 
-from tests.web.conftest import free_port, library_overrides
+from tests.web.browser import SHOTS, get_json, served, watched_page
 
 pytestmark = pytest.mark.slow
 playwright_api = pytest.importorskip("playwright.sync_api")
-
-CHROMIUM = "/usr/bin/chromium"
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
-SHOTS = Path("/tmp/web_check")
 expect = playwright_api.expect
 
 
@@ -41,73 +30,16 @@ def backends() -> list:
     return ["dry_run", mujoco]
 
 
-def get_json(url: str) -> dict:
-    with urllib.request.urlopen(url, timeout=5) as response:
-        return json.load(response)
-
-
 @pytest.fixture(scope="module", params=backends())
 def server(request, tmp_path_factory):
-    import shutil
-
-    from tests.web.conftest import SHIPPED
-
-    if not Path(CHROMIUM).exists():
-        pytest.skip("Debian chromium is not installed")
-    root = tmp_path_factory.mktemp(f"serve_{request.param}")
-    library = root / "library" / "g1"
-    shutil.copytree(SHIPPED, library, ignore=shutil.ignore_patterns(".backup"))
-    port = free_port()
-    with open(root / "server.log", "w") as log:
-        yield from _run_server(request.param, port, library, root, log)
-
-
-def _run_server(backend: str, port: int, library: Path, root: Path, log):
-    process = subprocess.Popen(
-        [sys.executable, "-m", "emopose", "+experiment=serve", f"backend={backend}", "planner=keyword",
-         f"serve.port={port}", "run.record=false", f"hydra.run.dir={root}/run", *library_overrides(library)],
-        stdout=log, stderr=subprocess.STDOUT, env={**os.environ, "MUJOCO_GL": "egl", "EMOPOSE_TOKEN": ""})
-    base = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 180
-    while time.monotonic() < deadline:
-        if process.poll() is not None:
-            pytest.fail(f"server exited early:\n{(root / 'server.log').read_text()[-3000:]}")
-        try:
-            get_json(f"{base}/api/health")
-            break
-        except OSError:
-            time.sleep(0.3)
-    else:
-        process.kill()
-        pytest.fail("server did not come up in 180 s")
-    yield {"base": base, "backend": backend, "library": library, "root": root}
-    process.send_signal(signal.SIGINT)  # a graceful stop: the job writes results.json
-    try:
-        process.wait(timeout=20)
-    except subprocess.TimeoutExpired:
-        process.kill()
-    assert (root / "run" / "results.json").is_file()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright_api.sync_playwright() as p:
-        launched = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
-        yield launched
-        launched.close()
+    with served(tmp_path_factory.mktemp(f"serve_{request.param}"), f"backend={request.param}") as info:
+        yield {**info, "backend": request.param}
 
 
 @pytest.fixture
 def page(browser, server):
-    context = browser.new_context(viewport={"width": 1400, "height": 900})
-    page = context.new_page()
-    foreign, errors = [], []
-    page.on("request", lambda r: None if r.url.startswith((server["base"], "data:", "blob:")) else foreign.append(r.url))
-    page.on("pageerror", lambda e: errors.append(str(e)))
-    yield page
-    context.close()
-    assert not foreign, f"the page fetched from outside the server: {foreign}"
-    assert not errors, f"JavaScript errors: {errors}"
+    with watched_page(browser, server["base"]) as page:
+        yield page
 
 
 def live_view(page, server):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from emopose.backends.g1 import wire
-from emopose.backends.g1.constants import ARM_MOTORS, WAIST_MOTORS, WEIGHT_MOTOR
+from emopose.robot.g1_spec import ARM_MOTORS, WAIST_MOTORS, WEIGHT_MOTOR
 
 _ARM = slice(ARM_MOTORS[0], ARM_MOTORS[-1] + 1)
 _WAIST = slice(WAIST_MOTORS[0], WAIST_MOTORS[-1] + 1)

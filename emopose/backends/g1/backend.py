@@ -17,19 +17,20 @@ import time
 
 import numpy as np
 
-from emopose import NUM_JOINTS
+from emopose.backends.base import Backend
 from emopose.backends.g1.errors import G1BackendError
 from emopose.backends.g1.handover import HandoverMixin
 from emopose.backends.g1.settings import G1Settings
 from emopose.clock import Clock, MonotonicClock
 from emopose.recording import Recorder
+from emopose.robot.g1_spec import NUM_JOINTS
 
 log = logging.getLogger(__name__)
 
 
-class G1Backend(HandoverMixin):
+class G1Backend(HandoverMixin, Backend):
     name = "g1"
-    realtime = True  # the run context drives this backend with the wall clock, never virtual time
+    realtime = True  # a real robot: the loop runs on the wall clock, never virtual time
 
     def __init__(
         self,

@@ -23,16 +23,11 @@ import numpy as np
 
 from emopose.backends.g1 import wire
 from emopose.backends.g1.arm_command import decode_arm_command
-from emopose.backends.g1.constants import (
-    LOCO_SERVICE,
-    NUM_MOTORS,
-    TOPIC_ARM_SDK,
-    TOPIC_LOWSTATE,
-    WEIGHT_MOTOR,
-)
+from emopose.backends.g1.constants import LOCO_SERVICE, TOPIC_ARM_SDK, TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession, queue_qos
 from emopose.backends.g1.fake_loco import FakeLoco
 from emopose.backends.g1.hg_types import LowCmd_, LowState_
+from emopose.robot.g1_spec import NUM_MOTORS, WEIGHT_MOTOR
 
 DEFAULT_ARM_POSE = [0.3, 0.25, 0.0, 0.9, 0.0, 0.1, 0.0, 0.3, -0.25, 0.0, 0.9, 0.0, 0.1, 0.0]
 _SDK_MOTORS = slice(12, 29)  # waist + arms: what arm_sdk may command

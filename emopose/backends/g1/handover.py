@@ -12,8 +12,9 @@ import logging
 import numpy as np
 
 from emopose.backends.g1 import profiles
-from emopose.backends.g1.constants import CONTROL_DT, TOPIC_LOWSTATE
+from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.errors import G1ConnectionError
+from emopose.robot.g1_spec import CONTROL_DT
 
 log = logging.getLogger("emopose.backends.g1.backend")
 

@@ -16,7 +16,7 @@ import cyclonedds.idl.annotations as annotate
 from cyclonedds import idl
 from cyclonedds.idl import types
 
-NUM_MOTORS = 35
+from emopose.robot.g1_spec import NUM_MOTORS
 
 
 @dataclass

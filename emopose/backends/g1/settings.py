@@ -10,15 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from emopose import NUM_JOINTS
-
-# Joint ranges of the G1 29-DoF arms (shared/reference/g1.md), library order: left arm
-# shoulder pitch/roll/yaw, elbow, wrist roll/pitch/yaw, then the right arm (roll mirrored).
-# Used only when the config does not provide limits (the lead wires library/g1/limits.yaml).
-_LEFT_LOWER = [-3.0892, -1.5882, -2.618, -1.0472, -1.97222, -1.61443, -1.61443]
-_LEFT_UPPER = [2.6704, 2.2515, 2.618, 2.0944, 1.97222, 1.61443, 1.61443]
-HW_LOWER = np.array([*_LEFT_LOWER, -3.0892, -2.2515, *_LEFT_LOWER[2:]])
-HW_UPPER = np.array([*_LEFT_UPPER, 2.6704, 1.5882, *_LEFT_UPPER[2:]])
+from emopose.robot import g1_spec
+from emopose.robot.g1_spec import NUM_JOINTS
 
 
 def per_joint(name: str, value: object, n: int = NUM_JOINTS) -> np.ndarray:
@@ -65,8 +58,9 @@ class G1Settings:
 
     @classmethod
     def build(cls, **kw: object) -> G1Settings:
-        lower = HW_LOWER.copy() if kw["lower"] is None else per_joint("lower", kw["lower"])
-        upper = HW_UPPER.copy() if kw["upper"] is None else per_joint("upper", kw["upper"])
+        # No limits in the config: the G1's hardware ranges.
+        lower = per_joint("lower", g1_spec.LOWER if kw["lower"] is None else kw["lower"])
+        upper = per_joint("upper", g1_spec.UPPER if kw["upper"] is None else kw["upper"])
         if np.any(lower >= upper):
             bad = np.flatnonzero(lower >= upper).tolist()
             raise ValueError(

@@ -14,9 +14,10 @@ from collections.abc import Callable
 import numpy as np
 
 from emopose.backends.g1 import wire
-from emopose.backends.g1.constants import ARM_MOTORS, TOPIC_LOWSTATE, WAIST_MOTORS
+from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession
 from emopose.backends.g1.hg_types import LowState_
+from emopose.robot.g1_spec import ARM_MOTORS, WAIST_MOTORS
 
 log = logging.getLogger(__name__)
 _ARM = slice(ARM_MOTORS[0], ARM_MOTORS[-1] + 1)

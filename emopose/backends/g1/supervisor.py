@@ -12,7 +12,8 @@ import logging
 import threading
 from typing import TYPE_CHECKING
 
-from emopose.backends.g1.constants import CONTROL_DT, TOPIC_LOWSTATE
+from emopose.backends.g1.constants import TOPIC_LOWSTATE
+from emopose.robot.g1_spec import CONTROL_DT
 
 if TYPE_CHECKING:
     from emopose.backends.g1.backend import G1Backend

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from emopose.backends.g1.constants import NUM_MOTORS
 from emopose.backends.g1.crc import crc32_words
+from emopose.robot.g1_spec import NUM_MOTORS
 
 # 4-byte encapsulation header: CDR little-endian (XCDR1). Final structs without 8-byte members
 # have the same body under XCDR2 (header 0x0007), which we also accept when decoding.

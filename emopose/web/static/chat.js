@@ -95,25 +95,47 @@ $("gesture-go").addEventListener("click", () => {
 });
 $("interrupt").addEventListener("click", () => socket.send({ type: "interrupt" }));
 
-// Microphone (only shown when the server has an ASR): record while pressed, send on release.
+// Microphone (only shown when the server has an ASR): record while held, send on release. getUserMedia
+// resolves only after the permission prompt, so a release that comes first stops the take as it starts
+// (otherwise a quick tap would leave the microphone recording).
 let recorder = null;
-$("mic").addEventListener("pointerdown", async () => {
+let held = false;
+
+async function startRecording() {
+  held = true;
   try {
     const stream = await navigator.mediaDevices.getUserMedia({ audio: true });
     const chunks = [];
-    recorder = new MediaRecorder(stream);
-    recorder.ondataavailable = (e) => chunks.push(e.data);
-    recorder.onstop = async () => {
+    const take = new MediaRecorder(stream);
+    take.ondataavailable = (e) => chunks.push(e.data);
+    take.onstop = () => {
       stream.getTracks().forEach((t) => t.stop());
-      const blob = new Blob(chunks, { type: recorder.mimeType.split(";")[0] });
-      const response = await fetch("/api/utterance/audio", { method: "POST", body: blob, headers: { "Content-Type": blob.type } });
-      if (!response.ok) showError((await response.json()).error);
+      sendRecording(new Blob(chunks, { type: take.mimeType.split(";")[0] }));
     };
-    recorder.start();
+    take.start();
+    recorder = take;
     $("mic").classList.add("recording");
+    if (!held) stopRecording();
   } catch (error) { showError(`microphone: ${error.message}`); }
-});
-$("mic").addEventListener("pointerup", () => {
+}
+
+function stopRecording() {
+  held = false;
   if (recorder && recorder.state === "recording") recorder.stop();
+  recorder = null;
   $("mic").classList.remove("recording");
-});
+}
+
+// The transcript comes back as an ordinary turn through the WebSocket; only a failure is answered here.
+async function sendRecording(blob) {
+  const response = await fetch("/api/utterance/audio",
+    { method: "POST", body: blob, headers: { "Content-Type": blob.type } });
+  if (!response.ok) {
+    const answer = await response.json().catch(() => ({}));
+    showError(answer.error || `microphone: HTTP ${response.status}`);
+  }
+}
+
+$("mic").addEventListener("pointerdown", startRecording);
+$("mic").addEventListener("pointerup", stopRecording);
+$("mic").addEventListener("pointercancel", stopRecording);

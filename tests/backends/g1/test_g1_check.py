@@ -1,22 +1,18 @@
 """g1_check end to end against the fake G1 on loopback DDS (a separate process)."""
 
 import pytest
-from hydra import compose, initialize_config_dir
 
 from emopose import app
-from emopose.config import CONFIG_DIR
 from tests.backends.g1.conftest import FakeRobot, require_dds  # noqa: F401 (domain_id fixture)
 
 
 @pytest.mark.slow
-def test_g1_check_runs_one_gesture_and_releases(tmp_path, domain_id):
+def test_g1_check_runs_one_gesture_and_releases(tmp_path, domain_id, compose):
     require_dds()
     robot = FakeRobot(domain_id, tmp_path / "fake.jsonl", [])
     try:
-        with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-            cfg = compose("config", overrides=["+experiment=g1_check", "planner=keyword",
-                                               f"backend.domain_id={domain_id}", "backend.weight_ramp_down_s=0.5",
-                                               "backend.release_blend_s=0.5", "job.gesture=chop_right"])
+        cfg = compose("+experiment=g1_check", "planner=keyword", f"backend.domain_id={domain_id}",
+                      "backend.weight_ramp_down_s=0.5", "backend.release_blend_s=0.5", "job.gesture=chop_right")
         results = app.run(cfg, tmp_path)
     finally:
         robot.stop()

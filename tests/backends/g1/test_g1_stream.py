@@ -5,8 +5,6 @@ The session runs once per module; each test checks one property of what the robo
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -55,14 +53,13 @@ def run(module_fake_robot, domain_id, tmp_path_factory):
         backend.send(i * 0.02, q)
     measured = backend.measured()
     backend.close()
-    started = time.perf_counter()
+    before = len(robot.wait_for("arm", 10**6, timeout_s=0.5))  # let the release land
     backend.close()
-    second_close_s = time.perf_counter() - started
     with pytest.raises(G1BackendError):
         backend.send(99.0, q0)
     expected = traj.copy()
     expected[-1, 3] = backend.settings.upper[3]
-    total = len(robot.wait_for("arm", 10**6, timeout_s=0.5))  # let the last messages land
+    total = len(robot.wait_for("arm", 10**6, timeout_s=0.5))  # anything the second close sent
     robot.stop()
     recorder.close()
     return {
@@ -70,8 +67,7 @@ def run(module_fake_robot, domain_id, tmp_path_factory):
         "expected": expected,
         "arm": robot.entries("arm"),
         "measured": measured,
-        "total": total,
-        "second_close_s": second_close_s,
+        "second_close_sent": total - before,
         "recording": read_recording(path),
         "backend": backend,
     }
@@ -134,7 +130,7 @@ def test_measured_tracks_the_commands(run):
 
 
 def test_close_twice_is_safe(run):
-    assert run["second_close_s"] < 0.1
+    assert run["second_close_sent"] == 0  # the arms were released once; nothing more went out
     assert run["backend"].state == "closed" and run["backend"].failure is None
     assert run["backend"].measured() is None
 

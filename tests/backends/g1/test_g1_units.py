@@ -8,9 +8,9 @@ import pytest
 from emopose.backends.base import Backend
 from emopose.backends.g1 import G1Backend, G1BackendError, profiles, wire
 from emopose.backends.g1.arm_command import ArmCommandBuilder, decode_arm_command
-from emopose.backends.g1.settings import HW_LOWER, HW_UPPER
+from emopose.robot import g1_spec
 
-DT = 0.02
+DT = g1_spec.CONTROL_DT
 
 
 def test_backend_satisfies_protocol_and_defaults():
@@ -21,7 +21,7 @@ def test_backend_satisfies_protocol_and_defaults():
     assert s.lowstate_loss_s == pytest.approx(0.2) and s.deadman_s == pytest.approx(0.1)
     assert np.all(s.kp == 60.0) and np.all(s.kd == 1.5)
     assert (s.weight_ramp_up_s, s.weight_ramp_down_s, s.command_waist) == (1.0, 3.0, False)
-    assert np.array_equal(s.lower, HW_LOWER) and np.array_equal(s.upper, HW_UPPER)
+    assert np.array_equal(s.lower, g1_spec.LOWER) and np.array_equal(s.upper, g1_spec.UPPER)
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,64 @@
+"""The run's lifecycle: the MCAP recorder, the backend connection and the 50 Hz control loop.
+
+Execution opens lazily and explicitly with `open()` (idempotent), so jobs that only plan (the
+benchmarks) never touch a simulator or a robot; `close()` always releases the robot and closes the
+recording, whatever happened.
+"""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import numpy as np
+
+from emopose.backends.base import Backend
+from emopose.control_loop import ControlLoop
+from emopose.recording import Recorder
+
+log = logging.getLogger(__name__)
+
+
+class Session:
+    def __init__(self, backend: Backend, loop: ControlLoop, neutral: np.ndarray, run_dir: str | Path,
+                 record: bool = True) -> None:
+        self.backend, self.loop, self.neutral = backend, loop, np.asarray(neutral, dtype=float)
+        self.run_dir, self.record = Path(run_dir), record
+        self.recorder: Recorder | None = None
+        self._open = False
+
+    @property
+    def is_open(self) -> bool:
+        return self._open
+
+    def open(self) -> ControlLoop:
+        """Connect the backend and start the 50 Hz stream at the measured pose (idempotent)."""
+        if self._open:
+            return self.loop
+        if self.record and self.recorder is None:
+            self.recorder = Recorder(self.run_dir / "session.mcap")
+        measured = self.backend.connect(self.recorder)
+        q0 = self.neutral if measured is None else np.asarray(measured, dtype=float)
+        self.loop.begin(q0, self.recorder)
+        self._open = True
+        return self.loop
+
+    def write(self, topic: str, payload: dict) -> None:
+        """Record a message at the current stream time (nothing before open() or without a recorder)."""
+        if self._open and self.recorder is not None:
+            self.recorder.write(topic, self.loop.stream_time, payload)
+
+    def close(self) -> None:
+        try:
+            if self._open:
+                self.loop.stop()
+            self.backend.close()
+        finally:
+            if self.recorder is not None:
+                self.recorder.close()
+
+    def __enter__(self) -> Session:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,52 @@
+"""The dispatch stage: starts the audio, then runs the loop until the awaited sequencer state."""
+
+import pytest
+
+from emopose.sequencer import State
+from emopose.stages.dispatch import Dispatch
+from tests.stages.test_sequence import scheduled_turn
+from tests.wiring import wire
+
+
+class CountingPlayer:
+    def __init__(self):
+        self.played = []
+
+    def play(self, clip, clock):
+        self.played.append(clip.text)
+        return clock.now()
+
+
+def submitted_turn(run):
+    run.session.open()
+    turn = scheduled_turn(run)
+    turn.submitted = run.stages[4](turn)
+    return turn
+
+
+@pytest.mark.parametrize("until, state", [("settle", State.HOLDING), ("rest", State.IDLE)])
+def test_runs_the_loop_until_the_awaited_state(library, tmp_path, until, state):
+    run = wire(library, tmp_path, record=False)
+    player = CountingPlayer()
+    turn = submitted_turn(run)
+    report = Dispatch(run.loop, player, until=until)(turn)
+    assert report.completed and run.sequencer.state == state
+    assert player.played == [turn.speech.text]
+    started = [e.name for e in report.events if e.kind == "started"]
+    assert started == [g.name for g in turn.modulated]
+    assert report.ticks == run.loop.stats.ticks > 0
+    assert report.speech_start == turn.submitted.speech_start  # virtual time: no gap between the stages
+
+
+def test_none_returns_at_once_and_a_timeout_is_reported(library, tmp_path):
+    run = wire(library, tmp_path, record=False)
+    turn = submitted_turn(run)
+    assert Dispatch(run.loop, CountingPlayer(), until="none")(turn).ticks == 0
+    late = Dispatch(run.loop, CountingPlayer(), timeout_s=0.1, until="rest")(turn)
+    assert not late.completed and late.ticks == 5  # 0.1 s of 50 Hz ticks
+
+
+def test_unknown_until_is_a_config_error(library, tmp_path):
+    run = wire(library, tmp_path)
+    with pytest.raises(ValueError, match="until must be one of"):
+        Dispatch(run.loop, run.player, until="forever")
