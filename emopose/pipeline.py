@@ -37,14 +37,16 @@ class PipelineError(ValueError):
 
 
 class Pipeline:
-    def __init__(self, stages: Mapping[str, Stage] | Sequence[Stage], hooks: Sequence[Hook] = ()) -> None:
+    def __init__(self, stages: Mapping[str, Stage] | Sequence[Stage], hooks: Sequence[Hook] = (),
+                 inputs: Sequence[str] = PLANNED) -> None:
+        """`inputs`: the Turn fields filled in before the first stage (a pipeline from resolve on takes a plan)."""
         items = list(stages.values()) if isinstance(stages, Mapping) else list(stages)
         self.stages: list[Stage] = [s for s in items if s is not None]
-        self.hooks = tuple(hooks)
-        self._check_order(0, PLANNED)
+        self.hooks, self.inputs = tuple(hooks), tuple(inputs)
+        self._check_order(0, self.inputs)
 
     def with_hooks(self, *hooks: Hook) -> Pipeline:
-        return Pipeline(self.stages, (*self.hooks, *hooks))
+        return Pipeline(self.stages, (*self.hooks, *hooks), self.inputs)
 
     def _check_order(self, first: int, inputs: Sequence[str]) -> None:
         known, available = set(Turn.field_names()), set(inputs)

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import pytest
-from hydra import compose, initialize_config_dir
 from hydra.errors import ConfigCompositionException
 from hydra.utils import instantiate
 
-from emopose.build import ConfigError, build_context, make
+from emopose.build import ConfigError, build_run, make
 from emopose.config import CONFIG_DIR
 
 HEAVY_PLANNERS = {"local", "sbert_centroids"}  # load MiniLM: covered by the slow planner tests
@@ -19,61 +18,58 @@ def options(group: str) -> list[str]:
     return sorted(p.stem for p in (CONFIG_DIR / group).glob("*.yaml"))
 
 
-def compose_with(*overrides: str):
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        return compose("config", overrides=list(overrides))
-
-
 @pytest.mark.parametrize("group,option", [(g, o) for g in GROUPS for o in options(g)])
-def test_every_group_option_composes_and_instantiates(group, option, library):
-    cfg = compose_with(f"{group}={option}")
-    node = cfg[group]
-    if group == "planner" and option in HEAVY_PLANNERS:
-        pytest.skip("loads a sentence encoder; instantiated in tests/planners (slow)")
-    if group == "planner":
+def test_every_group_option_composes(group, option, library, compose):
+    """Composition only; tests/test_config_consumed.py builds every option into a Run."""
+    node = compose(f"{group}={option}")[group]
+    assert node is not None
+    if group == "planner" and option not in HEAVY_PLANNERS:
         assert make(node, group, library=library).name
-    elif group == "pipeline":
-        for name, stage in node.stages.items():
-            assert make(stage, name).name == name
-    elif group == "sequencer":
-        from emopose.trajectory import TrajectoryBuilder
-
-        make(node, group, builder=TrajectoryBuilder(library.limits), neutral=library.neutral_entry.q[0])
-    elif group in ("library", "prompt"):
-        assert node is not None
-    else:
-        make(node, group)
 
 
 @pytest.mark.parametrize("experiment", options("experiment"))
-def test_every_experiment_composes_and_builds_its_job(experiment, tmp_path):
+def test_every_experiment_composes_and_builds_its_job(experiment, tmp_path, compose):
     recording = tmp_path / "session.mcap"
     recording.touch()
     required = {"replay": [f"mcap={recording}"]}  # experiments with a mandatory argument
-    cfg = compose_with(f"+experiment={experiment}", *required.get(experiment, []))
+    cfg = compose(f"+experiment={experiment}", *required.get(experiment, []))
     job = instantiate(cfg.job, _convert_="all")
     assert callable(job)
 
 
-def test_default_config_builds_a_context(tmp_path):
-    ctx = build_context(compose_with("planner=keyword"), tmp_path)
-    assert ctx.pipeline.names == ["parse", "resolve", "modulate", "schedule", "sequence", "dispatch"]
-    assert len(ctx.library.names) == 31
+def test_default_config_builds_a_run(tmp_path, compose):
+    with build_run(compose("planner=keyword"), tmp_path) as run:
+        assert run.resources.pipeline.names == ["parse", "resolve", "modulate", "schedule", "sequence", "dispatch"]
+        assert len(run.resources.library.names) == 31
+        assert run.runner.pipeline is run.resources.pipeline and not run.session.is_open
 
 
-def test_unknown_group_option_is_a_clear_error():
+def test_the_tour_pipeline_adds_aim_after_modulate_and_keeps_the_rest(tmp_path, compose):
+    with build_run(compose("pipeline=tour", "planner=keyword"), tmp_path) as run:
+        pipeline = run.resources.pipeline
+        assert pipeline.names == ["parse", "resolve", "modulate", "aim", "schedule", "sequence", "dispatch"]
+        assert pipeline.get("dispatch").until == "none" and pipeline.get("aim").scene is run.resources.scene
+
+
+def test_a_stage_without_a_place_in_the_order_is_refused(tmp_path, compose):
+    cfg = compose("planner=keyword", "+pipeline.stages.extra._target_=emopose.stages.parse.Parse")
+    with pytest.raises(ConfigError, match="\\['extra'\\] have no place in the order"):
+        build_run(cfg, tmp_path)
+
+
+def test_unknown_group_option_is_a_clear_error(compose):
     with pytest.raises(ConfigCompositionException, match="planner"):
-        compose_with("planner=gpt7")
+        compose("planner=gpt7")
 
 
-def test_wrong_stage_value_names_the_key(tmp_path):
-    cfg = compose_with("pipeline.stages.schedule.mode=sideways", "planner=keyword")
+def test_wrong_stage_value_names_the_key(tmp_path, compose):
+    cfg = compose("pipeline.stages.schedule.mode=sideways", "planner=keyword")
     with pytest.raises(ConfigError, match="pipeline.stages.schedule"):
-        build_context(cfg, tmp_path)
+        build_run(cfg, tmp_path)
 
 
-def test_hosted_llm_without_a_key_is_refused_before_the_run(tmp_path, monkeypatch):
+def test_hosted_llm_without_a_key_is_refused_before_the_run(tmp_path, monkeypatch, compose):
     monkeypatch.delenv("OPENAI_API_KEY", raising=False)
-    cfg = compose_with("planner=llm", "planner.model=openai/gpt-4o-mini")
+    cfg = compose("planner=llm", "planner.model=openai/gpt-4o-mini")
     with pytest.raises(ConfigError, match="OPENAI_API_KEY"):
-        build_context(cfg, tmp_path)
+        build_run(cfg, tmp_path)

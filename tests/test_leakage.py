@@ -4,7 +4,7 @@ No suite item (benchmark, context, sequence) may near-duplicate an in-context de
 (prompts/demonstrations.jsonl) or a training item (experiments/train/*.jsonl), and no suite may hold
 internal near-duplicates. Near-duplicate: equal normalised text, word-3-gram Jaccard >= 0.5, or >= 0.7
 3-gram containment for texts of >= 4 words (emopose.bench.near_duplicates; an inverted index over
-3-grams keeps this to seconds). Files not written yet are skipped, by name. A slow test adds a
+3-grams keeps this to seconds). Every file named here ships with the repository. A slow test adds a
 paraphrase check the word rules cannot see: no suite item may have a sentence-embedding cosine of
 PARAPHRASE_COSINE or more with a demonstration or training item (all-MiniLM-L6-v2).
 """
@@ -33,11 +33,19 @@ def texts_of(path: Path, prefix: str) -> list[Text]:
     return [Text.of(f"{prefix}:{row.get('id', k)}", row["text"]) for k, row in enumerate(rows)]
 
 
+def shipped(path: Path) -> Path:
+    assert path.is_file(), f"{path.relative_to(PROJECT_ROOT)} is missing: it ships with the repository"
+    return path
+
+
 def suite_texts(name: str) -> list[Text]:
-    path = SUITES[name]
-    if not path.is_file():
-        pytest.skip(f"{path.relative_to(PROJECT_ROOT)} not written yet")
-    return texts_of(path, name)
+    return texts_of(shipped(SUITES[name]), name)
+
+
+def training_texts() -> list[Text]:
+    files = sorted(TRAIN_DIR.glob("*.jsonl"))
+    assert files, "experiments/train/*.jsonl is missing: the training set ships with the repository"
+    return [t for f in files for t in texts_of(f, f"train/{f.stem}")]
 
 
 def report(pairs) -> str:
@@ -55,22 +63,14 @@ def test_no_internal_near_duplicates(suite):
 
 @pytest.mark.parametrize("suite", sorted(SUITES))
 def test_no_suite_item_near_duplicates_a_demonstration(suite):
-    texts = suite_texts(suite)
-    if not DEMONSTRATIONS.is_file():
-        pytest.skip("prompts/demonstrations.jsonl not written yet")
-    pairs = cross_duplicates(texts, texts_of(DEMONSTRATIONS, "demo"))
+    pairs = cross_duplicates(suite_texts(suite), texts_of(shipped(DEMONSTRATIONS), "demo"))
     if pairs:
         pytest.fail(report(pairs), pytrace=False)
 
 
 @pytest.mark.parametrize("suite", sorted(SUITES))
 def test_no_suite_item_near_duplicates_a_training_item(suite):
-    texts = suite_texts(suite)
-    train_files = sorted(TRAIN_DIR.glob("*.jsonl"))
-    if not train_files:
-        pytest.skip("experiments/train/*.jsonl not written yet")
-    training = [t for f in train_files for t in texts_of(f, f"train/{f.stem}")]
-    pairs = cross_duplicates(texts, training)
+    pairs = cross_duplicates(suite_texts(suite), training_texts())
     if pairs:
         pytest.fail(report(pairs), pytrace=False)
 
@@ -91,9 +91,7 @@ def sentence_encoder():
 @pytest.mark.parametrize("suite", sorted(SUITES))
 def test_no_suite_item_paraphrases_a_training_item_or_demonstration(suite, sentence_encoder):
     texts = suite_texts(suite)
-    others = [t for f in sorted(TRAIN_DIR.glob("*.jsonl")) for t in texts_of(f, f"train/{f.stem}")]
-    if DEMONSTRATIONS.is_file():
-        others += texts_of(DEMONSTRATIONS, "demo")
+    others = training_texts() + texts_of(shipped(DEMONSTRATIONS), "demo")
     similarity = sentence_encoder(texts) @ sentence_encoder(others).T
     rows, cols = (similarity >= PARAPHRASE_COSINE).nonzero()
     pairs = [f"{texts[i].key} ~ {others[j].key} (cosine {similarity[i, j]:.3f}): {texts[i].raw!r} / {others[j].raw!r}"

@@ -36,7 +36,3 @@ PAPER_SEQUENCE = {
         "over_total": (65, None), "under_total": (0, None),
     }
 }
-
-
-def paper_value(table: dict, method: str, metric: str) -> tuple[float, float | None] | None:
-    return table.get(method, {}).get(metric)

@@ -72,7 +72,8 @@ class SyncEvalJob:
         if missing:
             raise ValueError(f"sync_eval needs pipeline stages {missing}; pipeline has {configured.names}")
         return Pipeline([stages["resolve"], stages["modulate"], replace(stages["schedule"], mode=mode),
-                         replace(stages["sequence"], interrupt=False), replace(stages["dispatch"], until="rest")])
+                         replace(stages["sequence"], interrupt=False), replace(stages["dispatch"], until="rest")],
+                        inputs=("request", "plan"))
 
     def _run_item(self, res: Resources, runner: TurnRunner, item: SuiteItem) -> list[GestureSync]:
         turn = runner.run_plan(item.plan(), utterance=item.text)

@@ -5,10 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from hydra import compose, initialize_config_dir
 
 from emopose.app import run
-from emopose.config import CONFIG_DIR
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -22,13 +20,12 @@ def library_overrides(library) -> list[str]:
 
 
 @pytest.fixture
-def run_experiment(library_overrides, tmp_path):
+def run_experiment(library_overrides, tmp_path, compose):
     """run_experiment("bench_all", "bench.path=...", ...) -> (results dict, run_dir)."""
 
     def _run(experiment: str, *overrides: str, planner: str = "keyword"):
-        with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-            cfg = compose("config", overrides=[f"+experiment={experiment}", f"planner={planner}",
-                                               "job.progress=false", *library_overrides, *overrides])
+        cfg = compose(f"+experiment={experiment}", f"planner={planner}", "job.progress=false", *library_overrides,
+                      *overrides)
         run_dir = tmp_path / experiment
         return run(cfg, run_dir), run_dir
 

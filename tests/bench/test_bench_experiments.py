@@ -102,14 +102,19 @@ class FlakyPlanner(KeywordPlanner):
         return [self.plan(r) for r in requests]
 
 
+def planning_run(planner, tmp_path):
+    """What a planning-only job reads of a Run: the planner and the run directory."""
+    return SimpleNamespace(resources=SimpleNamespace(planner=planner, run_dir=tmp_path / "run"))
+
+
 def test_a_failing_item_is_recorded_and_the_run_continues(tmp_path):
     suite = tmp_path / "bench.jsonl"
     rows = [{"id": "a", "text": "Yes, exactly.", "label": "agreeing", "tier": "easy"},
             {"id": "b", "text": "boom goes the item", "label": "neutral", "tier": "easy"},
             {"id": "c", "text": "No, never.", "label": "rejecting", "tier": "easy"}]
     suite.write_text("".join(json.dumps(r) + "\n" for r in rows))
-    ctx = SimpleNamespace(planner=FlakyPlanner(), run_dir=tmp_path / "run")
-    results = BenchJob(path=str(suite), progress=False, confusion=False)(ctx)
+    run = planning_run(FlakyPlanner(), tmp_path)
+    results = BenchJob(path=str(suite), progress=False, confusion=False)(run)
     preds = {p["id"]: p for p in results["predictions"]}
     assert preds["b"]["pred"] is None and "model exploded" in preds["b"]["error"]
     assert preds["a"]["pred"] == "agreeing" and preds["c"]["pred"] == "rejecting"
@@ -121,8 +126,8 @@ def test_sampled_planner_defaults_to_five_passes(tmp_path):
         sampled = True
 
     suite = FIXTURES / "bench_small.jsonl"
-    ctx = SimpleNamespace(planner=Sampled(), run_dir=tmp_path / "run")
-    results = BenchJob(path=str(suite), tiers=["easy"], progress=False, confusion=False)(ctx)
+    run = planning_run(Sampled(), tmp_path)
+    results = BenchJob(path=str(suite), tiers=["easy"], progress=False, confusion=False)(run)
     assert results["passes"] == 5 and len(results["predictions"]) == 40
     assert results["accuracy"]["easy"]["sd"] == 0.0
 
@@ -132,7 +137,7 @@ def test_fallback_outputs_are_counted(tmp_path):
         def plan(self, request):
             return PlannerOutput(raw='{"gestures": [{"class": "agreeing", "intensity": "loud"}]}')
 
-    ctx = SimpleNamespace(planner=Garbled(), run_dir=tmp_path / "run")
+    run = planning_run(Garbled(), tmp_path)
     results = BenchJob(path=str(FIXTURES / "bench_small.jsonl"), tiers=["easy"], progress=False,
-                       confusion=False)(ctx)
+                       confusion=False)(run)
     assert results["fallbacks"] == 8 and results["failures"] == 0

@@ -1,15 +1,12 @@
-"""The shipped suite files: counts, balance, fields, anchor order and variants (skipped until a file exists)."""
+"""The shipped suite files: counts, balance, fields, anchor order and variants."""
 
 from collections import Counter
 from itertools import pairwise
 from pathlib import Path
 
-import pytest
-from hydra import compose, initialize_config_dir
-
 from emopose import CLASSES
 from emopose.bench.suites import TIERS, load_bench, load_context, load_sequence
-from emopose.config import CONFIG_DIR, PROJECT_ROOT
+from emopose.config import PROJECT_ROOT
 
 BENCH = PROJECT_ROOT / "experiments/bench/emopose_bench.jsonl"
 CONTEXT = PROJECT_ROOT / "experiments/context/context_suite.jsonl"
@@ -29,23 +26,8 @@ SPEC_MOTIONS = {
 
 
 def need(path: Path) -> Path:
-    if not path.is_file():
-        pytest.skip(f"{path.relative_to(PROJECT_ROOT)} not written yet")
+    assert path.is_file(), f"{path.relative_to(PROJECT_ROOT)} is missing: the suites ship with the repository"
     return path
-
-
-def g1_variant_classes() -> dict[str, str] | None:
-    """name -> class from the authored G1 library, or None while it cannot be loaded."""
-    from emopose.build import ConfigError, make
-    from emopose.library import LibraryError
-
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        cfg = compose("config")
-    try:
-        library = make(cfg.library, "library")
-    except (ConfigError, LibraryError, OSError):
-        return None
-    return {name: entry.cls for name, entry in library.snapshot.entries.items()}
 
 
 def test_bench_counts():
@@ -77,9 +59,8 @@ def test_sequence_variants_belong_to_their_class():
     load_sequence(need(SEQUENCE), variant_classes=spec)
 
 
-def test_sequence_variants_exist_in_the_g1_library():
-    need(SEQUENCE)
-    variant_classes = g1_variant_classes()
-    if variant_classes is None:
-        pytest.skip("library/g1 is not loadable yet")
-    load_sequence(SEQUENCE, variant_classes=variant_classes)
+def test_sequence_variants_exist_in_the_g1_library(compose):
+    from emopose.build import make
+
+    library = make(compose().library, "library")  # the authored G1 set; failing to load it is a failure
+    load_sequence(need(SEQUENCE), variant_classes={n: e.cls for n, e in library.snapshot.entries.items()})

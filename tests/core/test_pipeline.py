@@ -80,3 +80,12 @@ def test_the_runner_records_each_value_when_its_stage_writes_it(wired, tmp_path)
     assert recording["/plan"][0][0] < recording["/dispatched"][0][0]
     times = [t for t, _ in recording["/joints/command"]]
     assert all(b > a for a, b in zip(times, times[1:]))
+
+
+def test_a_pipeline_from_resolve_on_takes_a_plan_as_input(wired):
+    with pytest.raises(PipelineError, match="reads \\['plan'\\]"):
+        Pipeline(wired.stages[1:])
+    tail = Pipeline(wired.stages[1:], inputs=("request", "plan"))
+    wired.session.open()
+    turn = tail.run(Turn(PlanRequest("Hi"), plan=Plan.scripted("Hi!", GestureRecord(cls="welcoming"))))
+    assert turn.dispatched.completed and turn.resolved[0].entry.cls == "welcoming"

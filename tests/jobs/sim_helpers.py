@@ -4,17 +4,9 @@ from __future__ import annotations
 
 import os
 
-from hydra import compose, initialize_config_dir
-
-from emopose.config import CONFIG_DIR
-from tests.conftest import make_library_dir
+from tests.conftest import compose_config, synthetic_library  # noqa: F401 -- re-exported for tests/jobs, tests/tour
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before the first mujoco import
-
-
-def compose_config(overrides: list[str]):
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        return compose("config", overrides=overrides)
 
 
 def _render_skip_reason() -> str | None:
@@ -32,11 +24,4 @@ RENDER_SKIP = _render_skip_reason()
 
 
 # Small frames keep rendering tests quick.
-SMALL_FRAMES = ["backend.width=96", "backend.height=72"]
-
-
-def synthetic_library(folder) -> list[str]:
-    """Overrides that swap in the small synthetic test library (tests/conftest.py) written to folder."""
-    make_library_dir(folder)
-    return [f"library.paths=[{folder}]", f"library.limits={folder}/limits.yaml", "library.write_dir=null",
-            "~library.class_defaults"]
+SMALL_FRAMES = ["backend.renderer.width=96", "backend.renderer.height=72"]

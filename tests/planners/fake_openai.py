@@ -3,7 +3,9 @@
 Real sockets, real HTTP: the planner under test talks to it through litellm exactly as it would to a
 hosted provider (api_base = server.url), so nothing inside litellm is mocked. Answers come from a
 FIFO script first, then from `default` (an Answer, or a callable (body, index) -> Answer). Every
-request body is recorded for assertions.
+request body is recorded for assertions, and two counters stand in for wall-clock bounds: `peak`
+(the most requests in progress at once: concurrency) and `answered` (answers sent so far; one still
+sitting out its delay is not, so a client that returned before it has timed out).
 
     with FakeOpenAI() as server:
         server.script(http_error(500), ok(PLAN_JSON))
@@ -119,6 +121,7 @@ class FakeOpenAI:
         self.requests: list[dict] = []
         self.paths: list[str] = []
         self.served: Counter[str] = Counter()  # answer kinds sent, e.g. {"ok": 9, "http_500": 1}
+        self.in_progress = self.peak = self.answered = 0
         self._script: deque[Answer] = deque()
         self._lock = threading.Lock()
         self._stopping = threading.Event()
@@ -160,6 +163,8 @@ class FakeOpenAI:
     def _next_answer(self, body: dict, path: str) -> Answer:
         with self._lock:
             index = len(self.requests)
+            self.in_progress += 1
+            self.peak = max(self.peak, self.in_progress)
             self.requests.append(body)
             self.paths.append(path)
             scripted = self._script.popleft() if self._script else None
@@ -167,6 +172,11 @@ class FakeOpenAI:
         with self._lock:
             self.served[answer.kind] += 1
         return answer
+
+    def _done(self, answered: bool) -> None:
+        with self._lock:
+            self.in_progress -= 1
+            self.answered += answered
 
     def stats(self) -> dict:
         with self._lock:
@@ -199,13 +209,14 @@ class FakeOpenAI:
                     return
                 answer = server._next_answer(body, self.path)
                 if answer.delay_s and server._stopping.wait(answer.delay_s):
-                    return
-                if answer.status != 200:
-                    self._send(answer.status, _error_body(answer.status), answer.headers)
+                    sent = False  # the server is shutting down
+                elif answer.status != 200:
+                    sent = self._send(answer.status, _error_body(answer.status), answer.headers)
                 else:
-                    self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
+                    sent = self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
+                server._done(sent)
 
-            def _send(self, status: int, payload: dict, headers: dict | None = None) -> None:
+            def _send(self, status: int, payload: dict, headers: dict | None = None) -> bool:
                 data = json.dumps(payload).encode()
                 try:
                     self.send_response(status)
@@ -216,7 +227,8 @@ class FakeOpenAI:
                     self.end_headers()
                     self.wfile.write(data)
                 except (BrokenPipeError, ConnectionResetError):
-                    pass  # the client gave up (a timeout test); nothing to tell it
+                    return False  # the client gave up (a timeout test); nothing to tell it
+                return True
 
         return Handler
 

@@ -1,7 +1,6 @@
 """The lexical and chance baselines: contract output, obvious cases, determinism, config validation."""
 
 import json
-import time
 from collections import Counter
 
 import pytest
@@ -81,13 +80,12 @@ def test_sbert_centroids_offline_batched_and_fitted_on_easy():
     requests = [PlanRequest(utterance=i.text) for i in items]
     warm = plan_all(planner, requests[:8])
     assert "model_load_s" in warm[0].meta
-    cpu = time.process_time()
+    batches = []  # items per forward pass of the encoder
+    planner._model.register_forward_hook(lambda module, args, out: batches.append(len(args[0]["input_ids"])))
     outputs = plan_all(planner, requests)
-    cpu = time.process_time() - cpu
     preds = [parse_plan(o.raw).top_class for o in outputs]
     easy = [p == i.label for p, i in zip(preds, items) if i.tier == "easy"]
     assert sum(easy) / len(easy) > 0.9  # centroids are fitted on these very items (as in the paper)
-    # Target: 480 items in <= 3 s wall after load on 2 idle cores. Wall time depends on what else the
-    # machine runs, so guard CPU time on one thread instead (about 3.3 s measured; per-item encoding
-    # instead of batches costs several times more).
-    assert cpu < 6.0, f"encoding 480 items took {cpu:.1f} s of CPU time"
+    # Batched: 480 items in ceil(480 / 64) forward passes, not 480 (per-item encoding costs several times
+    # the time; the wall-clock target, 480 items in <= 3 s on 2 idle cores: benchmarks/sbert_centroids.py).
+    assert sum(batches) == len(requests) and len(batches) == -(-len(requests) // planner.batch_size)

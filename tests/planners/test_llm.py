@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import time
 
 import pytest
 from fake_openai import (
@@ -71,10 +70,10 @@ def test_client_errors_are_not_retried(fake_openai, make_llm_planner, status):
 def test_timeouts_are_retried_then_fall_back(fake_openai, make_llm_planner):
     fake_openai.default = slow(3.0)
     planner = make_llm_planner(timeout_s=0.3, max_retries=1)
-    started = time.perf_counter()
     out = planner.plan(WELCOME)
     assert out.fallback and "Timeout" in out.error
-    assert fake_openai.count == 2 and time.perf_counter() - started < 2.5
+    # both attempts were given up before their 3 s answer came (wall time: benchmarks/llm_latency.py)
+    assert fake_openai.count == 2 and fake_openai.answered == 0
 
 
 def test_rerun_is_served_from_the_cache(fake_openai, make_llm_planner):
@@ -188,9 +187,9 @@ def test_plan_many_is_concurrent_and_ordered(fake_openai, make_llm_planner):
     fake_openai.default = _echo
     planner = make_llm_planner(concurrency=8)
     requests = [PlanRequest(f"utterance {k}") for k in range(16)]
-    started = time.perf_counter()
     outputs = plan_all(planner, requests)
-    assert time.perf_counter() - started < 1.5  # two waves of 0.2 s, not sixteen
+    # eight at a time, never more (wall time of the two waves: benchmarks/llm_latency.py)
+    assert fake_openai.peak == 8 and fake_openai.answered == 16
     assert [json.loads(o.raw)["reply"] for o in outputs] == [r.utterance for r in requests]
     stats = planner.stats()
     assert stats["calls"] == 16 and stats["latency_mean_s"] >= 0.2 and stats["latency_p95_s"] >= 0.2

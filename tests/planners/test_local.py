@@ -94,14 +94,10 @@ def test_train_local_search_is_checked_before_anything_is_built():
     ("planner.training.lr=-0.1", "lr must not be negative"),
     ("planner.temperature=0", "temperature must be positive"),
 ])
-def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message):
-    from hydra import compose, initialize_config_dir
-
+def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message, compose):
     from emopose.build import ConfigError, make
-    from emopose.config import CONFIG_DIR
 
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=["planner=local", f"planner.cache_dir={tmp_path}", override])
+    cfg = compose("planner=local", f"planner.cache_dir={tmp_path}", override)
     with pytest.raises(ConfigError, match=re.escape(message)):
         make(cfg.planner, "planner", library=make(cfg.library, "library"))
     assert not list(tmp_path.iterdir())  # nothing trained, nothing cached
@@ -119,18 +115,14 @@ def test_segments_keep_spans_and_boundary_strength():
 @pytest.fixture(scope="module")
 def planner(tmp_path_factory):
     """The configured local planner (same training files and cache as the app) on a copy of the library."""
-    from hydra import compose, initialize_config_dir
-
     from emopose.build import make
-    from emopose.config import CONFIG_DIR
+    from tests.conftest import compose_config  # the compose fixture is per test; this one is per module
 
     folder = tmp_path_factory.mktemp("lib") / "g1"
     shutil.copytree(PROJECT_ROOT / "library/g1", folder)
     library = MotionLibrary.from_config(paths=[str(folder)], limits=str(folder / "limits.yaml"),
                                         write_dir=str(folder))
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=["planner=local"])
-    return make(cfg.planner, "planner", library=library)
+    return make(compose_config(["planner=local"]).planner, "planner", library=library)
 
 
 @pytest.mark.slow

@@ -5,30 +5,18 @@ from __future__ import annotations
 import json
 
 import pytest
-from hydra import compose, initialize_config_dir
 
 from emopose.app import run
 from emopose.build import make
-from emopose.config import CONFIG_DIR, project_path
-from tests.conftest import make_library_dir
+from emopose.config import project_path
+from tests.conftest import synthetic_library
 
 FIXTURE_SUITE = project_path("experiments/speech/sync_fixture.jsonl")
 
 
-def _compose(overrides):
-    with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        return compose("config", overrides=overrides)
-
-
-def _library_overrides(folder):
-    return [f"library.paths=[{folder}]", f"library.limits={folder}/limits.yaml", "library.write_dir=null",
-            "~library.class_defaults"]
-
-
-def test_sync_eval_reports_both_modes_and_meets_the_words_target(tmp_path):
-    folder = make_library_dir(tmp_path / "library")
-    cfg = _compose(["+experiment=sync_eval", f"job.suite={FIXTURE_SUITE}", f"tts.audio_dir={tmp_path / 'tts'}",
-                    *_library_overrides(folder)])
+def test_sync_eval_reports_both_modes_and_meets_the_words_target(tmp_path, compose):
+    cfg = compose("+experiment=sync_eval", f"job.suite={FIXTURE_SUITE}", f"tts.audio_dir={tmp_path / 'tts'}",
+                  *synthetic_library(tmp_path / "library"))
     results = run(cfg, tmp_path / "run")
     assert json.loads((tmp_path / "run" / "results.json").read_text())["items"] == 8
     assert "Say-do check: 1 record" in (tmp_path / "run" / "results.md").read_text()
@@ -41,26 +29,25 @@ def test_sync_eval_reports_both_modes_and_meets_the_words_target(tmp_path):
     assert results["say_do"]["records"] == [{"item": "sync-fix-08", "k": 1, "trigger": "give or take it"}]
 
 
-def test_sync_eval_falls_back_to_the_fixture_and_needs_true_word_events(tmp_path):
-    folder = make_library_dir(tmp_path / "library")
-    common = [f"job.suite={tmp_path / 'absent.jsonl'}", "job.limit=2", *_library_overrides(folder)]
-    results = run(_compose(["+experiment=sync_eval", f"tts.audio_dir={tmp_path / 'tts'}", *common]), tmp_path / "run")
+def test_sync_eval_falls_back_to_the_fixture_and_needs_true_word_events(tmp_path, compose):
+    common = [f"job.suite={tmp_path / 'absent.jsonl'}", "job.limit=2", *synthetic_library(tmp_path / "library")]
+    results = run(compose("+experiment=sync_eval", f"tts.audio_dir={tmp_path / 'tts'}", *common), tmp_path / "run")
     assert results["suite"] == FIXTURE_SUITE and results["items"] == 2
     with pytest.raises(ValueError, match="tts=espeak"):
-        run(_compose(["+experiment=sync_eval", "tts=none", *common]), tmp_path / "run2")
+        run(compose("+experiment=sync_eval", "tts=none", *common), tmp_path / "run2")
 
 
 @pytest.mark.parametrize("group, option", [("asr", "none"), ("asr", "litellm"), ("player", "auto"),
                                            ("player", "none"), ("tts", "espeak"), ("tts", "litellm")])
-def test_speech_config_options_build(group, option, tmp_path):
+def test_speech_config_options_build(group, option, tmp_path, compose):
     overrides = [f"{group}={option}"]
     if group == "tts":
         overrides.append(f"tts.audio_dir={tmp_path}")
-    node = _compose(overrides)[group]
+    node = compose(*overrides)[group]
     assert make(node, group) is not None
 
 
-def test_thinking_options_build(tmp_path, library):
-    assert make(_compose(["thinking=none"]).get("thinking"), "thinking") is None
-    node = _compose(["thinking=chin_stroke", "thinking.motion=doubting_a"]).thinking
+def test_thinking_options_build(tmp_path, library, compose):
+    assert make(compose("thinking=none").get("thinking"), "thinking") is None
+    node = compose("thinking=chin_stroke", "thinking.motion=doubting_a").thinking
     assert make(node, "thinking", library=library).motion == "doubting_a"
