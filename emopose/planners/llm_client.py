@@ -25,6 +25,15 @@ TRANSIENT_STATUS = frozenset({408, 409, 429})
 NO_KEY_PLACEHOLDER = "no-key-needed"  # the OpenAI SDK refuses a missing key even for a local server
 
 
+def effective_api_key(litellm, model: str, api_base: str | None, api_key: str | None) -> str | None:
+    """The configured key; else None, so litellm reads the provider's env var; a keyless local server
+    (api_base set, no key anywhere) gets a placeholder: the OpenAI SDK refuses to send without one.
+    One rule for every litellm call (planner, speech recognition, speech synthesis)."""
+    if api_key or not api_base:
+        return api_key
+    return None if litellm.validate_environment(model=model).get("keys_in_environment") else NO_KEY_PLACEHOLDER
+
+
 class LLMConfigError(ValueError):
     """The planner's model configuration cannot work; raised by check() before a benchmark starts."""
 
@@ -166,11 +175,7 @@ class LLMClient:
     def _effective_key(self) -> str | None:
         """The configured key; else litellm reads the provider's env var; a keyless local server gets a placeholder."""
         if self._key_resolved is None:
-            key = self.api_key
-            if key is None and self.api_base:
-                has_env = _litellm().validate_environment(model=self.model).get("keys_in_environment")
-                key = None if has_env else NO_KEY_PLACEHOLDER
-            self._key_resolved = (key,)
+            self._key_resolved = (effective_api_key(_litellm(), self.model, self.api_base, self.api_key),)
         return self._key_resolved[0]
 
     def _draw_key(self, messages: list[dict], pass_index: int) -> str:

@@ -12,7 +12,7 @@ import time
 from abc import ABC, abstractmethod
 from pathlib import Path
 
-from emopose.planners.llm_client import NO_KEY_PLACEHOLDER
+from emopose.planners.llm_client import effective_api_key
 
 log = logging.getLogger(__name__)
 
@@ -76,7 +76,8 @@ class LitellmTranscriber(Recognizer):
         try:
             with path.open("rb") as handle:
                 response = litellm.transcription(model=self.model, file=handle, api_base=self.api_base,
-                                                 api_key=self._api_key(litellm), timeout=self.timeout_s,
+                                                 api_key=effective_api_key(litellm, self.model, self.api_base,
+                                                                           self.api_key), timeout=self.timeout_s,
                                                  **optional)
         except Exception as exc:
             raise ASRError(f"transcription of {path.name} by {self.model} at {self.api_base or 'provider default'} "
@@ -87,10 +88,3 @@ class LitellmTranscriber(Recognizer):
         log.info("transcribed %s in %.2f s: %r", path.name, self.last_latency_s, text[:80])
         return text
 
-    def _api_key(self, litellm) -> str | None:
-        """The configured key; else the provider's env var; a keyless local server (asr.api_base set, no
-        key anywhere) gets a placeholder, because the OpenAI SDK refuses to send a request without one."""
-        if self.api_key or not self.api_base:
-            return self.api_key
-        return None if litellm.validate_environment(model=self.model).get("keys_in_environment") \
-            else NO_KEY_PLACEHOLDER

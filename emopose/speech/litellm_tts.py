@@ -14,6 +14,7 @@ import logging
 import re
 from pathlib import Path
 
+from emopose.planners.llm_client import effective_api_key
 from emopose.speech.clip import SpeechClip, WordTiming
 from emopose.speech.espeak import EspeakSynthesizer
 from emopose.speech.espeak_lib import EspeakUnavailable
@@ -54,8 +55,9 @@ class LitellmSpeech:
     def _hosted(self, text: str) -> tuple[Path, float]:
         import litellm  # heavy import, only when hosted speech is used
 
+        key = effective_api_key(litellm, self.model, self.api_base, self.api_key)  # a keyless local server too
         response = litellm.speech(model=self.model, input=text, voice=self.voice, api_base=self.api_base,
-                                  api_key=self.api_key, response_format="wav", timeout=self.timeout_s)
+                                  api_key=key, response_format="wav", timeout=self.timeout_s)
         audio = response.content
         duration = wav_duration(audio)  # raises on a non-WAV answer: T_a must come from real samples
         path = self.audio_dir / f"{clip_key('litellm', self.model, self.voice, text)}.wav"

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import itertools
-import time
 from pathlib import Path
 
 import numpy as np
@@ -164,14 +163,16 @@ def test_neutral_poses_are_clean(library):
         assert report.ok, f"{name}: {report.reason}"
 
 
-def test_check_is_vectorised_and_fast():
+def test_check_is_vectorised(monkeypatch):
+    """A batch is one pass through the kinematics (its time is in benchmarks/construction.py), and the
+    batch verdict is the per-sample one."""
+    import emopose.robot.collision as collision
+
     samples = np.random.default_rng(1).uniform(-0.6, 0.6, (250, 14))
-    checker = SelfCollisionChecker()
-    checker.check(samples)
-    runs = []
-    for _ in range(20):
-        start = time.perf_counter()
-        checker.check(samples)
-        runs.append(time.perf_counter() - start)
-    # Measured well under 1 ms on a quiet core; the bound only catches a per-sample Python loop.
-    assert np.median(runs) < 0.02
+    calls = []
+    chain = collision.mirrored_chain
+    monkeypatch.setattr(collision, "mirrored_chain", lambda *a: calls.append(a[0].shape) or chain(*a))
+    gaps = SelfCollisionChecker().clearances(samples)
+    assert calls == [(250, 2, 7)]
+    one_by_one = np.vstack([SelfCollisionChecker().clearances(q) for q in samples[:20]])
+    assert np.allclose(gaps[:20], one_by_one, atol=1e-5)

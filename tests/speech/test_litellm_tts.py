@@ -24,6 +24,15 @@ def test_hosted_audio_gives_its_duration_and_estimated_words(tmp_path):
     assert clip.onset_at_char(REPLY.index("kg")) > clip.onset_at_char(REPLY.index("3.5"))
 
 
+def test_a_keyless_local_server_is_reached_without_a_key(tmp_path, monkeypatch):
+    monkeypatch.delenv("OPENAI_API_KEY", raising=False)
+    with FakeAudioServer(speech_seconds=1.0) as server:
+        tts = LitellmSpeech(model="openai/tts-1", api_base=server.url, audio_dir=str(tmp_path))
+        clip = tts.synthesize("Hello there.")
+    assert server.requests and not clip.audio_path.name.startswith("espeak")
+    assert clip.duration_s == pytest.approx(1.0)  # the server's audio, not the espeak fallback
+
+
 def test_hosted_failure_falls_back_to_espeak_with_a_warning(tmp_path, caplog):
     with FakeAudioServer() as server:
         server.status = 401
