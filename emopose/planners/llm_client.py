@@ -26,9 +26,8 @@ NO_KEY_PLACEHOLDER = "no-key-needed"  # the OpenAI SDK refuses a missing key eve
 
 
 def effective_api_key(litellm, model: str, api_base: str | None, api_key: str | None) -> str | None:
-    """The configured key; else None, so litellm reads the provider's env var; a keyless local server
-    (api_base set, no key anywhere) gets a placeholder: the OpenAI SDK refuses to send without one.
-    One rule for every litellm call (planner, speech recognition, speech synthesis)."""
+    """For every litellm call: the configured key; else None (litellm reads the provider's env var); a keyless
+    local server (api_base set, no key anywhere) gets a placeholder: the OpenAI SDK refuses to send without one."""
     if api_key or not api_base:
         return api_key
     return None if litellm.validate_environment(model=model).get("keys_in_environment") else NO_KEY_PLACEHOLDER
@@ -173,8 +172,7 @@ class LLMClient:
         return kwargs
 
     def _effective_key(self) -> str | None:
-        """The configured key; else litellm reads the provider's env var; a keyless local server gets a placeholder."""
-        if self._key_resolved is None:
+        if self._key_resolved is None:  # asked once: validate_environment reads the environment
             self._key_resolved = (effective_api_key(_litellm(), self.model, self.api_base, self.api_key),)
         return self._key_resolved[0]
 
