@@ -73,11 +73,10 @@ class Pipeline:
         return next((s for s in self.stages if s.name == name), None)
 
     def _first(self, turn: Turn, start: str | None) -> int:
-        if start is None:
-            return 0
-        if start not in self.names:
+        """The index of the first stage to run, checked against what the turn already holds."""
+        if start is not None and start not in self.names:
             raise PipelineError(f"cannot start at '{start}': the pipeline is {self.names}")
-        first = self.names.index(start)
+        first = 0 if start is None else self.names.index(start)
         self._check_order(first, [f for f in Turn.field_names() if getattr(turn, f) is not None])
         return first
 

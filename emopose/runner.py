@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from emopose.contract import Plan
-from emopose.pipeline import Pipeline, Stage
+from emopose.pipeline import Pipeline, PipelineError, Stage
 from emopose.planners.base import Planner, PlanRequest
 from emopose.session import Session
 from emopose.thinking import ThinkingGesture
@@ -59,6 +59,8 @@ class TurnRunner:
         self._record(turn, "request")
         self._record(turn, "plan")
         start = next((s.name for s in self.pipeline.stages if "plan" in s.reads), None)
+        if start is None:
+            raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} reads it")
         self._run_stages(turn, start)
         return turn
 

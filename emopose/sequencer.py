@@ -22,7 +22,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
 
 import numpy as np
@@ -118,6 +118,17 @@ class Sequencer:
                 self._start_blend(now, np.asarray(first.keyframes[0]), self.interrupt_blend_s, first)
             else:
                 self._start_blend(now, self.neutral, self.recover_s, None)
+
+    def retime(self, ids: set[int], delta: float) -> int:
+        """Move the release of the queued commands in `ids` by delta seconds (their speech started that much
+        later than planned); returns how many moved. Commands already running are not touched."""
+        with self._lock:
+            moved = 0
+            for k, command in enumerate(self._queue):
+                if command.id in ids:
+                    self._queue[k] = replace(command, release_at=command.release_at + delta)
+                    moved += 1
+            return moved
 
     @property
     def pending(self) -> list[GestureCommand]:

@@ -8,6 +8,7 @@ recording, whatever happened.
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +43,16 @@ class Session:
         self.loop.begin(q0, self.recorder)
         self._open = True
         return self.loop
+
+    def restart(self, q0: np.ndarray) -> None:
+        """Start the stream afresh at q0 (after the caller re-posed a simulator): stream time from zero."""
+        self.open()
+        self.loop.begin(np.asarray(q0, dtype=float), self.recorder)
+
+    def tap(self, wrap: Callable[[Backend], Backend]) -> Backend:
+        """Route the stream through wrap(backend) from now on (a measurement tap); returns the wrapper."""
+        self.loop.backend = wrap(self.loop.backend)
+        return self.loop.backend
 
     def write(self, topic: str, payload: dict) -> None:
         """Record a message at the current stream time (nothing before open() or without a recorder)."""

@@ -1,1 +1,2 @@
-"""Jobs: what an experiment does with a run context (conf/experiment/*.yaml sets `job`)."""
+"""Jobs: what an experiment does with a Run: its resources, session and turn runner
+(conf/experiment/*.yaml sets `job`; emopose/resources.py)."""

@@ -1,7 +1,7 @@
 """+experiment=g1_check: connect to the G1, read its state, run one gesture gently, release, report.
 
 The hand-over is the backend's: connect() refuses to start without fresh rt/lowstate and ramps the
-arm_sdk weight up while holding the measured pose; closing the context blends to neutral and ramps
+arm_sdk weight up while holding the measured pose; closing the session blends to neutral and ramps
 the weight down. The gesture goes through the normal resolve..dispatch stages at low intensity.
 """
 

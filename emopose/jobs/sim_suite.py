@@ -58,8 +58,7 @@ class SimSuiteJob:
         order = np.random.default_rng(self.seed).permutation(
             np.repeat(np.array(CLASSES), self.trials // len(CLASSES)))
         loop = run.session.open()
-        tap = StreamTap(loop.backend)
-        loop.backend = tap  # capture command/state pairs in memory, tick by tick
+        tap = run.session.tap(StreamTap)  # capture command/state pairs in memory, tick by tick
         t0 = res.clock.now() - loop.stream_time
         rows = [self._trial(run, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
         results = self._summarise(run, rows)

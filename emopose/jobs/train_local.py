@@ -1,6 +1,6 @@
 """+experiment=train_local: (re)train the local planner and score it on the held-out training slice.
 
-Building the context trains the planner if no cached artifact matches the training files and
+Building the run trains the planner if no cached artifact matches the training files and
 hyper-parameters (delete the cache file, or change planner.training.seed, to force a retrain). The
 held-out slice is every training item (single- and multi-act) whose id hashes into
 planner.training.holdout_percent; those never enter training. The benchmark suites are not touched:
@@ -58,7 +58,7 @@ class TrainLocalJob:
     search: dict[str, list[float]] | None = None  # split parameter -> values to try
 
     def __post_init__(self) -> None:
-        """Check job.search when the job is built, before the context (and any training) is."""
+        """Check job.search when the job is built, before the run (and any training) is."""
         search = self.search or {}
         unknown = set(search) - set(SPLIT_PARAMETERS)
         if unknown:

@@ -1,5 +1,9 @@
 """Dispatch: start the reply's audio and run the submitted commands through the 50 Hz control loop.
 
+The sequence stage released the gestures against the planned speech start; when the audio actually
+starts at another time (a device's launch and output latency), the queued gestures are moved by the
+difference, so they keep their place on the words as heard.
+
 When the loop already runs on its own thread (web UI, tour, G1), dispatch waits on it if asked to;
 otherwise it drives the loop on this thread until the sequencer settles (offline rendering with a
 fake clock, or real time with the monotonic clock).
@@ -36,8 +40,11 @@ class Dispatch:
 
     def __call__(self, turn: Turn) -> DispatchReport:
         sequencer = self.loop.sequencer
-        speech_start = self.player.play(turn.speech, self.loop.clock)
         first_event, ticks = len(sequencer.events), self.loop.stats.ticks
+        speech_start = self.player.play(turn.speech, self.loop.clock)
+        late = speech_start - turn.submitted.speech_start
+        if late:
+            sequencer.retime({c.id for c in turn.submitted.commands}, late)
         if self.until == "none":
             done = True
         elif self.until == "settle":

@@ -1,7 +1,8 @@
 """Sequence: scheduled gestures -> commands queued in the sequencer, released against the speech start.
 
 The speech start is planned here (now, plus the audio device's expected latency) and the dispatch stage
-starts the audio; gestures are released at speech start + their scheduled release. Trajectory
+starts the audio (moving the gestures if it starts at another time); gestures are released at speech
+start + their scheduled release. Trajectory
 construction (Eq. smoothstep) happens inside the sequencer when a command is dequeued, so it starts
 from the pose actually published at that moment. This stage measures the paper's "command submission"
 latency: the non-blocking hand-off into the sequencer's queue.

@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Literal
 
+from emopose.robot.g1_spec import CONTROL_DT
 from emopose.tour.geometry import Pose2D, wrap_angle
 
 Phase = Literal["turn", "drive", "align", "done"]
@@ -30,7 +31,7 @@ class GoToPose:
     heading_gain: float = 1.5
     distance_gain: float = 1.0
     final_approach_m: float = 0.2
-    dt: float = 0.02
+    dt: float = CONTROL_DT
     phase: Phase = "turn"
     _vx: float = field(default=0.0, repr=False)
     _wz: float = field(default=0.0, repr=False)

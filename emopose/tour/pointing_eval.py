@@ -98,7 +98,7 @@ class PointingEvalJob:
         loop, backend, sequencer = session.loop, session.backend, session.loop.sequencer
         backend.reset(session.neutral)  # arms at rest, base at the origin; then stand at the pose
         base.place(pose)
-        loop.begin(session.neutral, session.recorder)
+        session.restart(session.neutral)
         local = map_to_torso(target, pose)
         aimed, report = stage.aim(entry.q, local, entry.name, name)
         side = 0 if report.side == "left" else 1

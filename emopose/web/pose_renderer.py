@@ -1,6 +1,6 @@
 """MuJoCo frames for the web UI, rendered kinematically on one dedicated thread.
 
-Why not backend.render_frame(): rendering in the 50 Hz control thread (backend.render=true) costs
+Why not the backend's renderer: rendering in the 50 Hz control thread (backend.renderer.live=true) costs
 50-1000 ms a frame under software EGL and would make the loop miss its deadlines. Here one worker
 thread owns its own model, MjData and Renderer (an EGL context is current in one thread only, and
 several contexts created and freed in one process corrupted frames under Mesa), sets the pose to

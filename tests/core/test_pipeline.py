@@ -89,3 +89,9 @@ def test_a_pipeline_from_resolve_on_takes_a_plan_as_input(wired):
     wired.session.open()
     turn = tail.run(Turn(PlanRequest("Hi"), plan=Plan.scripted("Hi!", GestureRecord(cls="welcoming"))))
     assert turn.dispatched.completed and turn.resolved[0].entry.cls == "welcoming"
+
+
+def test_a_turn_missing_what_the_first_stage_reads_is_refused_before_it_runs(wired):
+    tail = Pipeline(wired.stages[1:], inputs=("request", "plan"))
+    with pytest.raises(PipelineError, match="reads \\['plan'\\]"):
+        tail.run(Turn(PlanRequest("Hi")))

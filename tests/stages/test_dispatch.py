@@ -50,3 +50,20 @@ def test_unknown_until_is_a_config_error(library, tmp_path):
     run = wire(library, tmp_path)
     with pytest.raises(ValueError, match="until must be one of"):
         Dispatch(run.loop, run.player, until="forever")
+
+
+def test_gestures_follow_the_audio_when_it_starts_later_than_planned(library, tmp_path):
+    class LateDevice(CountingPlayer):
+        def play(self, clip, clock):
+            super().play(clip, clock)
+            return clock.now() + 0.13  # launch plus an output latency the plan did not know
+
+    run = wire(library, tmp_path, record=False)
+    turn = submitted_turn(run)
+    planned = [c.release_at for c in turn.submitted.commands]
+    report = Dispatch(run.loop, LateDevice(), until="settle")(turn)
+    started = {e.command_id: e.t for e in report.events if e.kind == "started"}
+    assert report.speech_start == turn.submitted.speech_start + 0.13
+    first, second = turn.submitted.commands
+    assert 0 <= started[first.id] - (planned[0] + 0.13) <= 0.02 + 1e-9  # within one tick of the shift
+    assert started[second.id] >= planned[1] + 0.13  # never before its word as heard (it may queue)
