@@ -26,13 +26,21 @@ class PlanJob:
                          r.trigger or "-", f"{release.release_s:.2f} s ({release.how})"])
         table = markdown_table(["class", "requested", "resolved", "rule", "intensity", "trigger", "release"], rows)
         started = [e for e in turn.dispatched.events if e.kind == "started"]
+        data = turn.to_json()
         results = {
             "utterance": self.utterance,
             "planner": res.planner.name,
-            "turn": turn.to_json(),
+            "reply": data["plan"]["reply"],
+            "plan_source": data["plan"]["source"],
+            "records": data["plan"]["records"],
+            "resolved": data["resolved"],
+            "releases_s": [r["release_s"] for r in data["schedule"]["releases"]],
+            "speech_duration_s": data["speech"]["duration_s"],
             "executed": [{"name": e.name, "t": e.t} for e in started],
             "completed": turn.dispatched.completed,
             "mcap": str(recorder.path) if recorder else None,
+            "stage_ms": data["stage_ms"],
+            "turn": data,  # every value of the turn, as the MCAP recording holds it
         }
         text = (f"Utterance: {self.utterance}\nReply: {turn.plan.reply}  (plan from {turn.plan.source}, "
                 f"planner {res.planner.name})\n\n{table}\n\nSpeech {turn.speech.duration_s:.2f} s; "

@@ -55,21 +55,11 @@ def test_planar_base_refuses_use_before_connect():
         MujocoPlanarBase().pose()
 
 
-def test_fixed_base_by_default_and_transitional_base_velocity_needs_a_base():
+def test_fixed_base_by_default():
     backend = connected()
     names = {backend.model.joint(i).name for i in range(backend.model.njnt)}
     assert backend.planar_base is None and not names & set(BASE_JOINTS)
     assert backend.model.nq == len(JOINT_NAMES)
-    with pytest.raises(RuntimeError, match="needs a planar_base"):
-        backend.set_base_velocity(0.3, 0.0, 0.0)
-
-
-def test_transitional_set_base_velocity_drives_the_attached_base():
-    base = MujocoPlanarBase()
-    backend = connected(planar_base=base)
-    backend.set_base_velocity(0.0, 0.0, 0.5)
-    run_ticks(backend, np.zeros((50, 14)))
-    assert base.pose()[2] == pytest.approx(0.5, abs=0.03)
 
 
 def test_default_renderer_renders_nothing_while_running():
@@ -81,13 +71,6 @@ def test_default_renderer_renders_nothing_while_running():
 def test_render_before_connect_is_a_clear_error():
     with pytest.raises(RuntimeError, match="before connect"):
         MujocoBackend().render_frame()
-
-
-def test_video_path_is_the_renderers(tmp_path):
-    renderer = SimRenderer()
-    backend = MujocoBackend(renderer=renderer)
-    backend.video_path = str(tmp_path / "tour.mp4")  # how the tour points the video at its run dir
-    assert renderer.video_path == backend.video_path
 
 
 def _egl_skip_reason() -> str | None:

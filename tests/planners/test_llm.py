@@ -180,7 +180,8 @@ def test_unreadable_image_falls_back(fake_openai, make_llm_planner, tmp_path):
 
 def _echo(body: dict, index: int) -> Answer:
     utterance = body["messages"][-1]["content"]
-    return Answer(content=json.dumps({"reply": utterance, "gestures": []}), delay_s=0.2)
+    # long enough that all eight of a wave are in flight together even on a loaded machine
+    return Answer(content=json.dumps({"reply": utterance, "gestures": []}), delay_s=1.0)
 
 
 def test_plan_many_is_concurrent_and_ordered(fake_openai, make_llm_planner):
@@ -192,7 +193,7 @@ def test_plan_many_is_concurrent_and_ordered(fake_openai, make_llm_planner):
     assert fake_openai.peak == 8 and fake_openai.answered == 16
     assert [json.loads(o.raw)["reply"] for o in outputs] == [r.utterance for r in requests]
     stats = planner.stats()
-    assert stats["calls"] == 16 and stats["latency_mean_s"] >= 0.2 and stats["latency_p95_s"] >= 0.2
+    assert stats["calls"] == 16 and stats["latency_mean_s"] >= 1.0 and stats["latency_p95_s"] >= 1.0
 
 
 def test_plan_many_works_inside_a_running_event_loop(fake_openai, make_llm_planner):

@@ -7,7 +7,7 @@ import json
 import pytest
 
 from emopose.app import run
-from emopose.build import make
+from emopose.build import build_run, make
 from emopose.config import project_path
 from tests.conftest import synthetic_library
 
@@ -47,7 +47,10 @@ def test_speech_config_options_build(group, option, tmp_path, compose):
     assert make(node, group) is not None
 
 
-def test_thinking_options_build(tmp_path, library, compose):
-    assert make(compose("thinking=none").get("thinking"), "thinking") is None
-    node = compose("thinking=chin_stroke", "thinking.motion=doubting_a").thinking
-    assert make(node, "thinking", library=library).motion == "doubting_a"
+def test_thinking_options_build(tmp_path, compose):
+    with build_run(compose("thinking=none", "planner=keyword"), tmp_path / "none") as run:
+        assert run.runner.thinking is None
+    cfg = compose("thinking=chin_stroke", "thinking.motion=shrug", "planner=keyword")
+    with build_run(cfg, tmp_path / "shrug") as run:
+        thinking = run.runner.thinking
+        assert thinking.motion == "shrug" and thinking.sequencer is run.resources.sequencer

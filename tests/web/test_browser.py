@@ -75,6 +75,8 @@ def test_interrupt_clears_the_queue(page, server):
     page.fill("#say-text", "Welcome! Look over there. This is really important. I am not sure, maybe.")
     page.click("#send")
     expect(page.locator("#seq-queue li").first).not_to_have_text("empty", timeout=10_000)
+    # the turn's cues are on the page (the message follows the hand-off to the sequencer) before the click
+    expect(page.locator(".bubble.robot").last.locator(".cue").first).to_be_visible(timeout=10_000)
     page.click("#interrupt")
     expect(page.locator("#seq-queue li")).to_have_text(["empty"], timeout=5_000)
     expect(page.locator(".bubble.robot").last.locator(".cue.cancelled").first).to_be_visible()
