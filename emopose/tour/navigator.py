@@ -36,6 +36,13 @@ class MobileBase(Protocol):
         """Called once per control period after the world advanced (odometry integration)."""
 
 
+@runtime_checkable
+class GroundTruthBase(Protocol):
+    """A base that also knows where it really is (a simulator): used only to score the tour."""
+
+    def true_pose(self) -> Pose2D: ...
+
+
 @dataclass(frozen=True)
 class NavigationSettings:
     max_vx: float = 0.3

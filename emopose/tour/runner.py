@@ -19,7 +19,7 @@ from emopose.planners.base import Planner
 from emopose.resources import Run
 from emopose.tour.camera import Camera
 from emopose.tour.interruptions import Interruptions, Question, asks_about_scene, wants_abort
-from emopose.tour.navigator import MobileBase, NavigationSettings, Navigator
+from emopose.tour.navigator import GroundTruthBase, MobileBase, NavigationSettings, Navigator
 from emopose.tour.report import Exchange, StopResult, TourReport
 from emopose.tour.scenario import StopSpec, TourSpec
 from emopose.tour.scene_view import SceneView
@@ -89,8 +89,7 @@ class TourRunner:
         leg = self.navigator.go_to(goal, poll=lambda t: self._poll("leg", stop.name, t), handle=self.answer)
         started = sum(e.kind == "started" for e in self.sequencer.events[events_before:])
         answered = sum(len(x.gestures) for x in self.report.exchanges[exchanges_before:])  # given standing
-        true_pose = getattr(self.base, "true_pose", None)
-        truth = true_pose() if true_pose is not None else None
+        truth = self.base.true_pose() if isinstance(self.base, GroundTruthBase) else None
         result = StopResult(
             name=stop.name, reached=leg.reached, leg_s=leg.duration_s, pauses=leg.pauses,
             odometry_error_m=leg.odometry_error_m,

@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 from emopose.clock import Clock
 from emopose.session import Session
-from emopose.tour.navigator import MobileBase
+from emopose.tour.navigator import GroundTruthBase, MobileBase
 
 
 class TourWorld:
@@ -56,6 +56,5 @@ class TourWorld:
 
     def record_base(self) -> None:
         self.record("/base/odometry", self.base.odometry().as_dict())
-        true_pose = getattr(self.base, "true_pose", None)
-        if true_pose is not None:
-            self.record("/base/true", true_pose().as_dict())
+        if isinstance(self.base, GroundTruthBase):
+            self.record("/base/true", self.base.true_pose().as_dict())
