@@ -19,7 +19,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from emopose.clock import FakeClock, MonotonicClock
 from emopose.control_loop import ControlLoop
-from emopose.pipeline import Pipeline
+from emopose.pipeline import Pipeline, PipelineError
 from emopose.resources import Resources, Run
 from emopose.runner import TurnRunner
 from emopose.session import Session
@@ -114,7 +114,11 @@ def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
               "safety": safety}
     stages = {name: make_with(node, f"pipeline.stages.{name}", shared)
               for name, node in ordered_stages(cfg.pipeline).items()}
-    resources = Resources(library=library, planner=planner, pipeline=Pipeline(stages), backend=backend,
+    try:
+        pipeline = Pipeline(stages)
+    except PipelineError as exc:  # a mis-ordered or ablated pipeline: refused before any model call
+        raise ConfigError(f"pipeline: {exc}") from exc
+    resources = Resources(library=library, planner=planner, pipeline=pipeline, backend=backend,
                           sequencer=sequencer, clock=clock, synthesizer=shared["synthesizer"], player=player,
                           asr=make(cfg.get("asr"), "asr"), scene=shared["scene"], run_dir=Path(run_dir))
     session = Session(backend, loop, library.neutral_entry.q[0], run_dir, record=bool(cfg.run.record))

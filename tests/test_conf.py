@@ -73,3 +73,9 @@ def test_hosted_llm_without_a_key_is_refused_before_the_run(tmp_path, monkeypatc
     cfg = compose("planner=llm", "planner.model=openai/gpt-4o-mini")
     with pytest.raises(ConfigError, match="OPENAI_API_KEY"):
         build_run(cfg, tmp_path)
+
+
+def test_an_ablated_pipeline_is_a_one_line_config_error(tmp_path, compose):
+    cfg = compose("planner=keyword", "pipeline.stages.modulate=null")
+    with pytest.raises(ConfigError, match="pipeline: stage 'schedule' reads \\['modulated'\\]"):
+        build_run(cfg, tmp_path)
