@@ -109,9 +109,9 @@ def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
                      neutral=library.neutral_entry.q[0], safety=safety)
     loop = ControlLoop(sequencer, backend, clock)
     player = make(cfg.get("player"), "player") or Player(sink="none")
-    shared = {"library": library, "limits": library.limits, "synthesizer": make(cfg.tts, "tts"),
-              "sequencer": sequencer, "clock": clock, "loop": loop, "player": player, "scene": SceneSlot(),
-              "safety": safety}
+    synthesizer, scene = make(cfg.tts, "tts"), SceneSlot()
+    shared = {"library": library, "limits": library.limits, "synthesizer": synthesizer, "sequencer": sequencer,
+              "clock": clock, "loop": loop, "player": player, "scene": scene, "safety": safety}
     stages = {name: make_with(node, f"pipeline.stages.{name}", shared)
               for name, node in ordered_stages(cfg.pipeline).items()}
     try:
@@ -119,11 +119,11 @@ def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
     except PipelineError as exc:  # a mis-ordered or ablated pipeline: refused before any model call
         raise ConfigError(f"pipeline: {exc}") from exc
     resources = Resources(library=library, planner=planner, pipeline=pipeline, backend=backend,
-                          sequencer=sequencer, clock=clock, synthesizer=shared["synthesizer"], player=player,
-                          asr=make(cfg.get("asr"), "asr"), scene=shared["scene"], run_dir=Path(run_dir))
+                          sequencer=sequencer, clock=clock, synthesizer=synthesizer, player=player,
+                          asr=make(cfg.get("asr"), "asr"), scene=scene, run_dir=Path(run_dir))
     session = Session(backend, loop, library.neutral_entry.q[0], run_dir, record=bool(cfg.run.record))
     thinking = make_with(cfg.get("thinking"), "thinking", shared)
-    return Run(resources, session, TurnRunner(planner, resources.pipeline, session, thinking))
+    return Run(resources, session, TurnRunner(planner, pipeline, session, thinking))
 
 
 def build_job(cfg: DictConfig) -> Any:

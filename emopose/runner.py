@@ -9,6 +9,7 @@ reads a plan, with no planner call and no JSON round trip.
 
 from __future__ import annotations
 
+from contextlib import nullcontext
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -46,7 +47,7 @@ class TurnRunner:
         turn = Turn(PlanRequest(utterance=utterance, history=history, image=image))
         self._record(turn, "request")
         self.plan(turn, planner or self.planner)
-        self._run_stages(turn, None)
+        self._recorded.run(turn)
         if remember:
             self.history.extend([{"role": "user", "content": utterance},
                                  {"role": "assistant", "content": turn.plan.reply}])
@@ -61,26 +62,22 @@ class TurnRunner:
         start = next((s.name for s in self.pipeline.stages if "plan" in s.reads), None)
         if start is None:
             raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} reads it")
-        self._run_stages(turn, start)
+        self._recorded.run(turn, start)
         return turn
 
     def plan(self, turn: Turn, planner: Planner) -> None:
         """The planner call, wrapped in the thinking gesture that masks its latency."""
-        if self.thinking is None:
+        with self.thinking.around_planning() if self.thinking is not None else nullcontext():
             turn.planner_output = planner.plan(turn.request)
-        else:
-            with self.thinking.around_planning():
-                turn.planner_output = planner.plan(turn.request)
         turn.stage_s["planner"] = turn.planner_output.latency_s
         self._record(turn, "planner_output")
-
-    def _run_stages(self, turn: Turn, start: str | None) -> None:
-        self._recorded.run(turn, start)
 
     def _recording_hook(self, stage: Stage, turn: Turn) -> None:
         for name in stage.writes:
             self._record(turn, name)
 
     def _record(self, turn: Turn, name: str) -> None:
+        if not self.session.recording:
+            return  # serialising a turn costs more than the stage that made it
         value: Any = turn.field_json(name)
         self.session.write(f"/{name}", value if isinstance(value, dict) else {name: value})

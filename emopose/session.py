@@ -32,6 +32,11 @@ class Session:
     def is_open(self) -> bool:
         return self._open
 
+    @property
+    def recording(self) -> bool:
+        """Whether write() records anything: open, with a recorder."""
+        return self._open and self.recorder is not None
+
     def open(self) -> ControlLoop:
         """Connect the backend and start the 50 Hz stream at the measured pose (idempotent)."""
         if self._open:
@@ -56,7 +61,7 @@ class Session:
 
     def write(self, topic: str, payload: dict) -> None:
         """Record a message at the current stream time (nothing before open() or without a recorder)."""
-        if self._open and self.recorder is not None:
+        if self.recording:
             self.recorder.write(topic, self.loop.stream_time, payload)
 
     def close(self) -> None:
