@@ -3,11 +3,13 @@
     python benchmarks/g1_publish.py [--seconds 60] [--messages 5000] [--domain-id N]
 
 Prints one JSON object:
-  latency: per-message cost over --messages back-to-back commands, in microseconds, for
-           build+CRC+write (the DDS link alone) and for the whole G1Backend.send() call;
+  latency: per-message cost of build+CRC+write over --messages back-to-back commands on a DDS
+           link of its own (G1Link, microseconds): the backend itself paces its commands at least
+           half a period apart, so it cannot be driven back to back;
   period:  a 50 Hz loop driven by absolute deadlines (MonotonicClock.sleep_until) for
            --seconds: error of each publication interval against 20 ms (p50/p99/max, ms),
-           and how late each send started after its deadline.
+           how late each send started after its deadline, and what each G1Backend.send() call
+           cost (validate, clamp, lock, build, CRC, write, record).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from emopose.backends.g1 import G1Backend
+from emopose.backends.g1.settings import G1Settings
 from emopose.clock import MonotonicClock
 
 
@@ -55,7 +58,7 @@ def stats_ms(samples: np.ndarray) -> dict:
 def start_fake(domain_id: int) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": f"{REPO}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "emopose.backends.g1.fake_robot", "--domain-id", str(domain_id)],
+        [sys.executable, "-m", "emopose.testing.fake_robot", "--domain-id", str(domain_id)],
         cwd=REPO,
         env=env,
         stdout=subprocess.PIPE,
@@ -67,37 +70,42 @@ def start_fake(domain_id: int) -> subprocess.Popen:
     return proc
 
 
-def measure_latency(backend: G1Backend, q0: np.ndarray, n: int) -> dict:
-    link_s, send_s = [], []
-    poses = q0[None, :] + 0.05 * np.sin(np.arange(n)[:, None] / 25.0)
-    for i in range(n):  # the DDS link alone: build + CRC + write
-        t0 = time.perf_counter()
-        with backend._lock:
-            backend._link.publish(poses[i], 1.0)
-        link_s.append(time.perf_counter() - t0)
-    for i in range(n):  # what the sequencer pays per tick: validate, clamp, lock, build, CRC, write
-        t0 = time.perf_counter()
-        backend.send(i * 0.02, poses[i])
-        send_s.append(time.perf_counter() - t0)
-    return {"messages": n, "build_crc_write_us": stats_us(link_s), "send_us": stats_us(send_s)}
+def measure_link(settings: G1Settings, n: int) -> dict:
+    """The DDS link alone (build + CRC + write), on its own participant."""
+    from emopose.backends.g1.link import G1Link
+
+    link = G1Link(settings, time.perf_counter)
+    try:
+        q0 = link.wait_for_robot()
+        poses = q0[None, :] + 0.05 * np.sin(np.arange(n)[:, None] / 25.0)
+        link_s = []
+        for i in range(n):
+            t0 = time.perf_counter()
+            link.publish(poses[i], 0.0)  # weight 0: the fake keeps its own pose
+            link_s.append(time.perf_counter() - t0)
+    finally:
+        link.close()
+    return {"messages": n, "build_crc_write_us": stats_us(link_s)}
 
 
 def measure_period(backend: G1Backend, q0: np.ndarray, seconds: float) -> dict:
     clock, dt = MonotonicClock(), 0.02
     n = round(seconds / dt)
-    stamps, late = np.empty(n), np.empty(n)
+    stamps, late, send_s = np.empty(n), np.empty(n), []
     deadline = clock.now()
     for k in range(n):
         deadline += dt
         clock.sleep_until(deadline)
         start = clock.now()
         backend.send(k * dt, q0 + 0.05 * np.sin(k / 25.0))
+        send_s.append(clock.now() - start)
         stamps[k], late[k] = start, start - deadline
     return {
         "seconds": seconds,
         "ticks": n,
         "period_error_ms": stats_ms(np.diff(stamps) - dt),
         "deadline_lateness_ms": stats_ms(late),
+        "send_us": stats_us(send_s),
     }
 
 
@@ -115,8 +123,8 @@ def main() -> None:
         release_blend_s=0.5,
     )
     try:
+        latency = measure_link(backend.settings, args.messages)
         q0 = backend.connect(None)
-        latency = measure_latency(backend, q0, args.messages)
         period = measure_period(backend, q0, args.seconds)
         status = backend.status()
     finally:

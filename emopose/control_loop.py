@@ -1,16 +1,22 @@
 """The 50 Hz loop: ticks the sequencer on absolute deadlines and hands each target to the backend.
 
-Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt) chains). With a
-FakeClock the same loop renders a run as fast as the CPU allows; with MonotonicClock it is real time.
-`run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background thread for
-the web UI, speech and the tour; `wait_until()` waits the right way for either.
+Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt) chains). Deadlines
+that passed a whole period ago, or before the previous command went out, are skipped, not sent in a
+burst: after a stall (or while nobody drove the loop, e.g. the planner was thinking) the loop
+re-anchors on its grid and counts what it skipped; and no command follows the previous one by less
+than half a period. The sequencer plays its samples tick by tick, so a skip delays a motion, never jumps it.
+With a FakeClock the same loop renders a run as fast as the CPU allows; with MonotonicClock it is
+real time. `run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background
+thread for the web UI, speech and the tour; `wait_until()` waits the right way for either.
 """
 
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -27,15 +33,30 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class LoopStats:
+    """Counters over the whole run, and the lateness of the last `window` ticks (a long serve must not
+    grow a list forever): percentiles are over that window, the maximum over the whole run."""
+
+    window: int = 3000  # one minute at 50 Hz
     ticks: int = 0
-    missed_deadlines: int = 0
-    lateness_s: list[float] = field(default_factory=list)
+    missed_deadlines: int = 0  # deadlines skipped because the loop fell behind while it was driven
+    stalls: int = 0  # how often it fell behind by a whole period and re-anchored
+    idle_ticks: int = 0  # deadlines skipped while nobody drove the loop (between run_until calls)
+    lateness_max_s: float = 0.0
+    lateness_s: deque[float] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.lateness_s = deque(maxlen=self.window)
+
+    def add(self, lateness: float) -> None:
+        self.ticks += 1
+        self.lateness_s.append(lateness)
+        self.lateness_max_s = max(self.lateness_max_s, lateness)
 
     def summary(self) -> dict:
         late = np.asarray(self.lateness_s or [0.0]) * 1e3
-        return {"ticks": self.ticks, "missed_deadlines": self.missed_deadlines,
-                "lateness_ms_p50": float(np.percentile(late, 50)),
-                "lateness_ms_p99": float(np.percentile(late, 99)), "lateness_ms_max": float(late.max())}
+        return {"ticks": self.ticks, "missed_deadlines": self.missed_deadlines, "stalls": self.stalls,
+                "idle_ticks": self.idle_ticks, "lateness_ms_p50": float(np.percentile(late, 50)),
+                "lateness_ms_p99": float(np.percentile(late, 99)), "lateness_ms_max": self.lateness_max_s * 1e3}
 
 
 class ControlLoop:
@@ -45,6 +66,8 @@ class ControlLoop:
         self.stats = LoopStats()
         self._t0: float | None = None
         self._tick = 0
+        self._last_sent = -np.inf  # clock time the previous command went out
+        self._resuming = True  # nobody drove the loop since the last tick: lag is idle time, not a stall
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self.error: BaseException | None = None
@@ -54,7 +77,12 @@ class ControlLoop:
         self.recorder = recorder
         self._t0 = self.clock.now()
         self._tick = 0
+        self._resuming = True
         self.sequencer.reset(q0, self._t0)
+        if recorder is not None:
+            if recorder.clock is not self.clock:
+                raise ValueError("control loop: the recorder must run on the loop's clock (one time base)")
+            recorder.start_stream(self._t0)
 
     @property
     def stream_time(self) -> float:
@@ -62,22 +90,34 @@ class ControlLoop:
 
     def tick(self) -> np.ndarray:
         deadline = self._t0 + (self._tick + 1) * self.dt
-        self.clock.sleep_until(deadline)
-        lateness = self.clock.now() - deadline
+        # Deadlines a whole period past, or at or before the previous send (it stood for them), are
+        # skipped: the loop re-anchors on the grid instead of bursting the backlog out.
+        covered = max(self.clock.now() - self.dt, self._last_sent)
+        behind = math.floor((covered - deadline) / self.dt + 1e-9) + 1 if covered >= deadline - 1e-12 else 0
+        if behind > 0:
+            self._tick += behind
+            deadline = self._t0 + (self._tick + 1) * self.dt
+            if self._resuming:
+                self.stats.idle_ticks += behind
+            else:
+                self.stats.missed_deadlines += behind
+                self.stats.stalls += 1
+        self._resuming = False
+        self.clock.sleep_until(max(deadline, self._last_sent + self.dt / 2))
+        self.stats.add(self.clock.now() - deadline)
         self._tick += 1
-        self.stats.ticks += 1
-        self.stats.lateness_s.append(lateness)
-        if lateness > self.dt:
-            self.stats.missed_deadlines += 1
         q = self.sequencer.step(deadline)
         t = deadline - self._t0
         self.backend.send(t, q)
+        self._last_sent = self.clock.now()
         if self.recorder is not None:
             self.recorder.write("/joints/command", t, {"t": t, "q": q.tolist()})
         return q
 
     def run_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
-        """Tick until done() (checked after each tick) or timeout (stream seconds). True if done."""
+        """Tick until done() (checked after each tick) or timeout (stream seconds). True if done.
+        Time since the previous drive (a planner call, say) is idle, skipped at the first tick."""
+        self._resuming = True
         end = self.stream_time + timeout_s
         while self.stream_time < end:
             self.tick()

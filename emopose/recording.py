@@ -1,7 +1,11 @@
 """MCAP recording: one JSON channel per kind of message, nanosecond timestamps, readable by Foxglove.
 
-Writers stamp each message with stream time t (seconds since the run started); the file stores
-`start_ns + t`, so several streams (commands, simulated state, plan, schedule) share one timeline.
+Every message of a recording lies on one monotonic time base: the recorder's clock (the session's
+loop clock), in seconds since the recorder opened; the file stores `start_ns` (the wall time at
+opening, so Foxglove shows real dates) plus that offset. Writers give either stream time t (the
+control loop's seconds since its stream began; `start_stream` says where that is on the clock, and
+a restarted stream moves it on, never back) or nothing (`write_now`: stamped on arrival, for
+messages with no tick of their own such as the G1's hand-over phases or the turn's plan).
 """
 
 from __future__ import annotations
@@ -12,6 +16,8 @@ import time
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
+
+from emopose.clock import Clock, MonotonicClock
 
 JOINT_STREAM_SCHEMA = {
     "type": "object",
@@ -26,7 +32,8 @@ GENERIC_SCHEMA = {"type": "object"}
 class Recorder:
     """Thread-safe MCAP writer. Channels are registered on first use."""
 
-    def __init__(self, path: str | Path, schemas: dict[str, dict] | None = None) -> None:
+    def __init__(self, path: str | Path, schemas: dict[str, dict] | None = None,
+                 clock: Clock | None = None) -> None:
         from mcap.writer import Writer
 
         self.path = Path(path)
@@ -38,7 +45,17 @@ class Recorder:
         self._channels: dict[str, int] = {}
         self._lock = threading.Lock()
         self._closed = False
+        self.clock = clock or MonotonicClock()
+        self.origin = self.clock.now()  # the recording's zero on its clock
+        self._stream_zero = self.origin  # where stream time 0 lies on the clock
         self.start_ns = time.time_ns()
+
+    def start_stream(self, zero: float) -> None:
+        """Stream time 0 is clock time `zero` from now on (a stream began, or began again)."""
+        with self._lock:
+            if zero < self._stream_zero:
+                raise ValueError(f"recorder: a stream cannot restart in the past ({zero} < {self._stream_zero})")
+            self._stream_zero = zero
 
     def _channel(self, topic: str) -> int:
         if topic not in self._channels:
@@ -52,14 +69,22 @@ class Recorder:
         return self._channels[topic]
 
     def write(self, topic: str, t: float, payload: dict[str, Any]) -> None:
-        stamp = self.start_ns + int(round(t * 1e9))
+        """Record payload at stream time t."""
         data = json.dumps(payload, separators=(",", ":")).encode()
         with self._lock:
-            if self._closed:
-                return
-            self._writer.add_message(
-                channel_id=self._channel(topic), log_time=stamp, publish_time=stamp, data=data
-            )
+            self._add(topic, self._stream_zero - self.origin + t, data)
+
+    def write_now(self, topic: str, payload: dict[str, Any]) -> None:
+        """Record payload at the clock's current time (stamped under the lock: in arrival order)."""
+        data = json.dumps(payload, separators=(",", ":")).encode()
+        with self._lock:
+            self._add(topic, self.clock.now() - self.origin, data)
+
+    def _add(self, topic: str, offset_s: float, data: bytes) -> None:
+        if self._closed:
+            return
+        stamp = self.start_ns + int(round(offset_s * 1e9))
+        self._writer.add_message(channel_id=self._channel(topic), log_time=stamp, publish_time=stamp, data=data)
 
     def close(self) -> None:
         with self._lock:

@@ -2,7 +2,9 @@
 
 Execution opens lazily and explicitly with `open()` (idempotent), so jobs that only plan (the
 benchmarks) never touch a simulator or a robot; `close()` always releases the robot and closes the
-recording, whatever happened.
+recording, whatever happened. The recorder runs on the loop's clock, so the loop's commands, the
+backend's own messages and the turn's records share one time base; `origin` is its zero (the run's
+start), for jobs that report times relative to the run.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ class Session:
         self.backend, self.loop, self.neutral = backend, loop, np.asarray(neutral, dtype=float)
         self.run_dir, self.record = Path(run_dir), record
         self.recorder: Recorder | None = None
+        self.origin: float | None = None  # loop-clock time at open(): the run's (and recording's) zero
         self._open = False
 
     @property
@@ -42,7 +45,9 @@ class Session:
         if self._open:
             return self.loop
         if self.record and self.recorder is None:
-            self.recorder = Recorder(self.run_dir / "session.mcap")
+            self.recorder = Recorder(self.run_dir / "session.mcap", clock=self.loop.clock)
+        if self.origin is None:
+            self.origin = self.recorder.origin if self.recorder is not None else self.loop.clock.now()
         measured = self.backend.connect(self.recorder)
         q0 = self.neutral if measured is None else np.asarray(measured, dtype=float)
         self.loop.begin(q0, self.recorder)
@@ -60,9 +65,15 @@ class Session:
         return self.loop.backend
 
     def write(self, topic: str, payload: dict) -> None:
-        """Record a message at the current stream time (nothing before open() or without a recorder)."""
+        """Record a message at the current time (nothing before open() or without a recorder)."""
         if self.recording:
-            self.recorder.write(topic, self.loop.stream_time, payload)
+            self.recorder.write_now(topic, payload)
+
+    def run_time(self, clock_time: float) -> float:
+        """Seconds since the run started (open()) of a time read from the loop's clock."""
+        if self.origin is None:
+            raise RuntimeError("session: run_time() before open()")
+        return clock_time - self.origin
 
     def close(self) -> None:
         try:

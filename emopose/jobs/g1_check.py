@@ -3,6 +3,9 @@
 The hand-over is the backend's: connect() refuses to start without fresh rt/lowstate and ramps the
 arm_sdk weight up while holding the measured pose; closing the session blends to neutral and ramps
 the weight down. The gesture goes through the normal resolve..dispatch stages at low intensity.
+A fault (no robot, lost state, a stalled stream) is a result too: results.json/results.md say what
+happened and when, and the process exits non-zero with one line, not a traceback. Event times are
+seconds since the run started (the session's open, the recording's zero).
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from emopose.backends.g1.errors import G1BackendError
 from emopose.contract import GestureRecord, Plan
 from emopose.jobs.report import write_results
 from emopose.resources import Run
@@ -22,25 +26,43 @@ class G1CheckJob:
     intensity: int = 1
 
     def __call__(self, run: Run) -> dict:
-        res = run.resources
+        res, session = run.resources, run.session
         entry = res.library.get(self.gesture)
         if entry is None:
             raise ValueError(f"g1_check: no motion '{self.gesture}' in the library (job.gesture)")
-        loop = run.session.open()
-        measured = res.backend.measured()
-        print(f"connected to {res.backend.name}; measured arm pose (rad): {np.round(measured, 3).tolist()}")
-        record = GestureRecord(cls=entry.cls, variant=entry.name, intensity=self.intensity)
-        turn = run.runner.run_plan(Plan.scripted(f"g1 check: {self.gesture}", record))
-        events = [(e.kind, e.name, round(e.t, 3)) for e in turn.dispatched.events if e.kind != "state"]
-        stats = loop.stats.summary()
-        results = {"backend": res.backend.name, "measured_start": np.asarray(measured).tolist(),
-                   "gesture": self.gesture, "intensity": self.intensity, "completed": turn.dispatched.completed,
-                   "events": events, "loop": stats}
-        write_results(res.run_dir, results, "\n".join([
-            f"# g1_check on {res.backend.name}", f"- start pose: {np.round(measured, 3).tolist()}",
-            f"- gesture {self.gesture} at intensity {self.intensity}: "
-            f"{'completed' if turn.dispatched.completed else 'NOT completed'}",
-            f"- events: {events}", f"- 50 Hz loop: {stats}", "- release: blend to neutral, weight ramp to 0 (on exit)"]))
-        print(f"ran {self.gesture} at intensity {self.intensity}: completed={turn.dispatched.completed}; "
-              f"loop {stats}; releasing (blend to neutral, arm_sdk weight -> 0)")
+        events = res.sequencer.events
+        first_event = events.total
+        results = {"backend": res.backend.name, "gesture": self.gesture, "intensity": self.intensity,
+                   "completed": False, "fault": None, "fault_at_s": None, "measured_start": None}
+        try:
+            session.open()
+            measured = res.backend.measured()
+            results["measured_start"] = np.asarray(measured).tolist()
+            print(f"connected to {res.backend.name}; measured arm pose (rad): {np.round(measured, 3).tolist()}")
+            record = GestureRecord(cls=entry.cls, variant=entry.name, intensity=self.intensity)
+            turn = run.runner.run_plan(Plan.scripted(f"g1 check: {self.gesture}", record))
+            results["completed"] = turn.dispatched.completed
+        except G1BackendError as exc:
+            results["fault"] = str(exc)
+            if session.origin is not None:
+                results["fault_at_s"] = round(session.run_time(res.clock.now()), 3)
+        results["events"] = [(e.kind, e.name, round(session.run_time(e.t), 3))
+                             for e in events.since(first_event) if e.kind != "state"]
+        results["loop"] = session.loop.stats.summary()
+        write_results(res.run_dir, results, self._markdown(results))
+        if results["fault"] is not None:
+            raise SystemExit(f"g1_check: FAULT at {results['fault_at_s']} s: {results['fault']} "
+                             f"(results in {res.run_dir})")
+        print(f"ran {self.gesture} at intensity {self.intensity}: completed={results['completed']}; "
+              f"loop {results['loop']}; releasing (blend to neutral, arm_sdk weight -> 0)")
         return results
+
+    def _markdown(self, r: dict) -> str:
+        start = np.round(r["measured_start"], 3).tolist() if r["measured_start"] is not None else "not measured"
+        outcome = ("completed" if r["completed"] else "NOT completed") if r["fault"] is None else \
+            f"FAULT at {r['fault_at_s']} s: {r['fault']}"
+        return "\n".join([
+            f"# g1_check on {r['backend']}", f"- start pose: {start}",
+            f"- gesture {r['gesture']} at intensity {r['intensity']}: {outcome}",
+            f"- events (s since the run started): {r['events']}", f"- 50 Hz loop: {r['loop']}",
+            "- release: blend to neutral, weight ramp to 0 (on exit)"])

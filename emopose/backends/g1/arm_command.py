@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from emopose.backends.g1 import wire
+import emopose.backends.g1.wire as wire
 from emopose.robot.g1_spec import ARM_MOTORS, WAIST_MOTORS, WEIGHT_MOTOR
 
 _ARM = slice(ARM_MOTORS[0], ARM_MOTORS[-1] + 1)

@@ -6,29 +6,38 @@ holding that pose at 50 Hz. send() clamps and publishes one LowCmd_ per tick. cl
 supervisor on a fault (lowstate lost, send() silent past the deadman), blends the targets to the
 neutral pose, ramps the weight back to 0 and stops publishing. After a fault the backend is
 failed: send() raises G1BackendError with the reason. close() is idempotent and thread-safe.
-cyclonedds is imported in connect() only, so building the backend from config stays cheap.
+The parts: Lifecycle (every state transition), ArmOutput (every LowCmd_ out, paced, recorded),
+Handover (ramps and release), Supervisor (the watchdog, through the narrow Supervised interface
+this class implements: vitals(), hold(), fail()). cyclonedds is imported in connect() only, so
+building the backend from config stays cheap.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
-import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from emopose.backends.base import Backend
 from emopose.backends.g1.errors import G1BackendError
-from emopose.backends.g1.handover import HandoverMixin
+from emopose.backends.g1.handover import Handover
+from emopose.backends.g1.lifecycle import ACTIVE, ArmState, Lifecycle
+from emopose.backends.g1.output import ArmOutput
 from emopose.backends.g1.settings import G1Settings
+from emopose.backends.g1.supervisor import Supervisor, Vitals
 from emopose.clock import Clock, MonotonicClock
 from emopose.recording import Recorder
 from emopose.robot.g1_spec import NUM_JOINTS
 
+if TYPE_CHECKING:
+    from emopose.backends.g1.link import G1Link  # imports cyclonedds: only in connect()
+
 log = logging.getLogger(__name__)
 
 
-class G1Backend(HandoverMixin, Backend):
+class G1Backend(Backend):
     name = "g1"
     realtime = True  # a real robot: the loop runs on the wall clock, never virtual time
 
@@ -56,39 +65,26 @@ class G1Backend(HandoverMixin, Backend):
             **{k: v for k, v in locals().items() if k not in ("self", "clock")}
         )
         self._clock = clock or MonotonicClock()
-        self._lock = threading.RLock()  # state, last command and every DDS write
+        self._life = Lifecycle()
         self._close_lock = threading.Lock()  # close() calls run one at a time
-        self._released = threading.Event()  # a release sequence has finished
-        self._state = "idle"  # idle ramping holding streaming releasing failed closed
-        self._failure: str | None = None
-        self._recorder: Recorder | None = None
-        self._link = None
-        self._supervisor = None
-        self._neutral = self.settings.neutral_pose
-        self._last_q = np.zeros(NUM_JOINTS)
-        self._weight = 0.0
+        self._link: G1Link | None = None
+        self._out: ArmOutput | None = None
+        self._handover: Handover | None = None
+        self._supervisor: Supervisor | None = None
         self._last_send = -np.inf
 
     # ----------------------------------------------------------------- Backend protocol
     def connect(self, recorder: Recorder | None) -> np.ndarray:
-        with self._lock:
-            if self._state != "idle":
-                raise G1BackendError(
-                    f"g1 backend: connect() called twice (backend is {self._state})"
-                )
-            self._state = "ramping"
-        self._recorder = recorder
+        self._life.start_connect()
         try:
-            hold = self._open()
-            self._ramp_up(hold)
+            hold = self._open(recorder)
+            self._handover.ramp_up()
         except BaseException:
             self._abort_connect()
             raise
-        from emopose.backends.g1.supervisor import Supervisor
-
-        with self._lock:
-            self._state = "holding"
-        self._supervisor = Supervisor(self)
+        self._life.connected()
+        s = self.settings
+        self._supervisor = Supervisor(self, self._clock.now, s.lowstate_loss_s, s.deadman_s)
         self._supervisor.start()
         return hold.copy()
 
@@ -99,24 +95,12 @@ class G1Backend(HandoverMixin, Backend):
                 f"g1 backend: send() needs {NUM_JOINTS} finite joint targets, got {q!r}"
             )
         clamped = np.clip(q, self.settings.lower, self.settings.upper)  # the robot edge re-checks
-        with self._lock:
-            if self._state not in ("holding", "streaming"):
-                raise G1BackendError(self._refusal())
-            crc = self._publish(clamped, 1.0)
-            self._last_send = self._clock.now()
-            self._state = "streaming"
-        if self._recorder is not None:
-            self._recorder.write(
-                "/g1/lowcmd",
-                t,
-                {
-                    "q": clamped.tolist(),
-                    "weight": 1.0,
-                    "crc": crc,
-                    "phase": "stream",
-                    "clamped": bool(np.any(clamped != q)),
-                },
+        with self._life.lock:
+            self._life.stream()
+            self._out.publish(
+                clamped, 1.0, "stream", t=t, clamped=bool(np.any(clamped != q))
             )
+            self._last_send = self._clock.now()
 
     def measured(self) -> np.ndarray | None:
         link = self._link
@@ -124,40 +108,61 @@ class G1Backend(HandoverMixin, Backend):
 
     def close(self) -> None:
         with self._close_lock:
-            with self._lock:
-                state = self._state
-                if state in ("holding", "streaming"):
-                    self._state = "releasing"
             try:
-                if state in ("holding", "streaming"):
-                    self.release(reason=None)
-                elif state == "releasing":  # the supervisor is handing the arms back: let it finish
-                    self._released.wait()
+                if self._life.claim_release():
+                    self._handover.release(reason=None)
+                elif self._life.state is ArmState.RELEASING:  # the supervisor is handing back
+                    self._life.wait_released()
             finally:
                 self._teardown()
 
     # ------------------------------------------------------------------ diagnostics
     @property
-    def state(self) -> str:
-        return self._state
+    def state(self) -> ArmState:
+        """A StrEnum: compares equal to its value ("streaming", ...)."""
+        return self._life.state
 
     @property
     def failure(self) -> str | None:
-        return self._failure
+        return self._life.failure
 
     def status(self) -> dict:
-        link = self._link
+        link, out = self._link, self._out
         return {
-            "state": self._state,
-            "failure": self._failure,
-            "weight": self._weight,
+            "state": self.state.value,
+            "failure": self.failure,
+            "weight": out.weight if out else 0.0,
             "lowstate_valid": link.monitor.valid if link else 0,
             "lowstate_bad_crc": link.monitor.bad_crc if link else 0,
             "lowstate_age_s": link.state_age() if link else float("inf"),
         }
 
+    # ------------------------------------------------------------------ Supervised
+    def vitals(self) -> Vitals:
+        with self._life.lock:
+            state, link = self._life.state, self._link
+            if state not in ACTIVE or link is None:
+                return Vitals(state, float("inf"), float("inf"), "")
+            return Vitals(
+                state, link.state_age(), self._clock.now() - self._last_send, link.where()
+            )
+
+    def hold(self) -> None:
+        with self._life.lock:
+            if self._life.state is ArmState.HOLDING:
+                self._out.publish(self._out.last_q, 1.0, "hold")
+
+    def fail(self, reason: str) -> None:
+        if not self._life.claim_release(fault=reason):
+            return  # close() or another fault has the release
+        log.error("g1 backend fault, releasing the arms: %s", reason)
+        try:
+            self._handover.release(reason)
+        except Exception:
+            log.exception("release after fault failed")
+
     # ------------------------------------------------------------------ internals
-    def _open(self) -> np.ndarray:
+    def _open(self, recorder: Recorder | None) -> np.ndarray:
         """DDS link up, robot seen; returns the pose to hold: the measured one, clamped."""
         try:
             from emopose.backends.g1.link import G1Link
@@ -176,43 +181,26 @@ class G1Backend(HandoverMixin, Backend):
                 "(the weight ramp makes the move gradual)",
                 np.flatnonzero(hold != measured).tolist(),
             )
-        if self._neutral is None:
-            self._neutral = hold.copy()  # hand back where the firmware had the arms
-        self._last_q = hold.copy()
+        # No configured neutral pose: hand back where the firmware had the arms.
+        neutral = hold.copy() if s.neutral_pose is None else s.neutral_pose
+        self._out = ArmOutput(self._link, self._clock, recorder, hold)
+        self._handover = Handover(s, self._clock, self._life, self._out, neutral)
         return hold
 
-    def _publish(self, q: np.ndarray, weight: float, phase: str | None = None) -> int:
-        """One LowCmd_ out. Caller holds self._lock. Internal phases are recorded here; send()
-        records its own message with the sequencer's stream time."""
-        crc = self._link.publish(q, weight)
-        self._last_q = q
-        self._weight = weight
-        if phase is not None:
-            self._record(
-                "/g1/lowcmd", {"q": q.tolist(), "weight": weight, "crc": crc, "phase": phase}
-            )
-        return crc
-
-    def _record(self, topic: str, payload: dict) -> None:
-        if self._recorder is not None:
-            self._recorder.write(topic, (time.time_ns() - self._recorder.start_ns) / 1e9, payload)
-
-    def _refusal(self) -> str:
-        if self._failure is not None:
-            return (
-                "g1 backend released the arms after a fault and accepts no more commands: "
-                f"{self._failure}"
-            )
-        if self._state in ("idle", "ramping"):
-            return "g1 backend: send() before connect() finished"
-        return f"g1 backend is {self._state}; send() is no longer accepted"
+    def _abort_connect(self) -> None:
+        """connect() failed or was interrupted: hand back whatever weight was given, tear down."""
+        try:
+            gave_weight = self._out is not None and self._out.weight > 0
+            if gave_weight and self._life.claim_release(allowed=frozenset({ArmState.RAMPING})):
+                self._handover.release(reason="connect() aborted", blend=False)
+        finally:
+            self._teardown()
 
     def _teardown(self) -> None:
         if self._supervisor is not None:
             self._supervisor.stop()
         if self._link is not None:
             self._link.close()
-        with self._lock:
+        with self._life.lock:
             self._link = None
-            if self._state != "failed":
-                self._state = "closed"
+        self._life.closed()

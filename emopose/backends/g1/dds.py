@@ -100,11 +100,15 @@ class RawReader:
 
     def take(self, timeout_s: float, max_samples: int = 64) -> list[bytes]:
         """Wait up to timeout_s for data, then take everything available (oldest first)."""
+        return [data for data, _ in self.take_stamped(timeout_s, max_samples)]
+
+    def take_stamped(self, timeout_s: float, max_samples: int = 64) -> list[tuple[bytes, int]]:
+        """Same, each with its source timestamp: when the writer wrote it (ns since the epoch)."""
         self._waitset.wait(duration(seconds=timeout_s))
         got = ddspy_take(self._condition._ref, max_samples)
         if isinstance(got, int):
             return []
-        return [data for data, info in got if info.valid_data]
+        return [(data, info.source_timestamp) for data, info in got if info.valid_data]
 
     def take_typed(self, timeout_s: float, max_samples: int = 16) -> list[Any]:
         """Same, deserialized with the library (for low-rate RPC messages)."""

@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from emopose.backends.g1 import wire
+import emopose.backends.g1.wire as wire
 from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession
 from emopose.backends.g1.hg_types import LowState_

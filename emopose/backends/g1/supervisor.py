@@ -1,32 +1,71 @@
 """The backend's watchdog thread: holds the pose until streaming starts, and trips on faults.
 
 Faults: no valid rt/lowstate for longer than lowstate_loss_ms, or (once send() has started) no
-send() for longer than deadman_ms: the sequencer stalled. On a fault the supervisor claims the
-release from the backend and runs it on this thread, so the hand-back happens even when the
-main thread is stuck. It polls with Event.wait (not a spin) so it costs no CPU between checks.
+send() for longer than deadman_ms: the sequencer stalled. On a fault the supervisor hands the
+release to the backend on this thread, so the hand-back happens even when the main thread is stuck.
+It sees the backend only through the narrow Supervised interface (a snapshot, a hold, a fault),
+never its lock or internals. It polls with Event.wait (not a spin): no CPU between checks.
 """
 
 from __future__ import annotations
 
 import logging
 import threading
-from typing import TYPE_CHECKING
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
 
 from emopose.backends.g1.constants import TOPIC_LOWSTATE
+from emopose.backends.g1.lifecycle import ACTIVE, ArmState
 from emopose.robot.g1_spec import CONTROL_DT
-
-if TYPE_CHECKING:
-    from emopose.backends.g1.backend import G1Backend
 
 log = logging.getLogger(__name__)
 
 
+@dataclass(frozen=True)
+class Vitals:
+    state: ArmState
+    lowstate_age_s: float  # since the newest valid rt/lowstate
+    idle_s: float  # since the last send() (inf before the first)
+    where: str  # the DDS domain and interface, for messages
+
+
+class Supervised(Protocol):
+    def vitals(self) -> Vitals: ...
+
+    def hold(self) -> None:
+        """Publish one tick at the held pose, if still holding."""
+
+    def fail(self, reason: str) -> None:
+        """Claim the release for a fault and run it on the calling thread (if nobody else has)."""
+
+
+def fault_reason(v: Vitals, lowstate_loss_s: float, deadman_s: float) -> str | None:
+    if v.lowstate_age_s > lowstate_loss_s:
+        return (
+            f"lost {TOPIC_LOWSTATE}: no valid LowState_ for {v.lowstate_age_s * 1e3:.0f} ms (limit "
+            f"{lowstate_loss_s * 1e3:.0f} ms, {v.where})"
+        )
+    if v.state is ArmState.STREAMING and v.idle_s > deadman_s:
+        return (
+            f"deadman: send() not called for {v.idle_s * 1e3:.0f} ms (limit "
+            f"{deadman_s * 1e3:.0f} ms): the sequencer stalled"
+        )
+    return None
+
+
 class Supervisor:
-    def __init__(self, backend: G1Backend) -> None:
-        self._backend = backend
-        s = backend.settings
+    def __init__(
+        self,
+        target: Supervised,
+        now: Callable[[], float],
+        lowstate_loss_s: float,
+        deadman_s: float,
+    ) -> None:
+        self._target, self._now = target, now
+        self._loss_s, self._deadman_s = lowstate_loss_s, deadman_s
         # Check at least 4x per deadman period so a stall is seen within ~1.25x the limit.
-        self._period = min(0.005, s.deadman_s / 4, s.lowstate_loss_s / 4)
+        self._period = min(0.005, deadman_s / 4, lowstate_loss_s / 4)
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._run, name="g1-supervisor", daemon=True)
 
@@ -39,35 +78,16 @@ class Supervisor:
             self._thread.join(timeout=10.0)
 
     def _run(self) -> None:
-        backend = self._backend
-        now = backend._clock.now
-        next_hold = now() + CONTROL_DT
+        next_hold = self._now() + CONTROL_DT
         while not self._stop.wait(self._period):
-            reason = None
-            with backend._lock:
-                state = backend.state
-                if state not in ("holding", "streaming"):
-                    return  # closing or already released: nothing left to watch
-                t = now()
-                age = backend._link.state_age()
-                idle = t - backend._last_send
-                if age > backend.settings.lowstate_loss_s:
-                    reason = (
-                        f"lost {TOPIC_LOWSTATE}: no valid LowState_ for {age * 1e3:.0f} ms (limit "
-                        f"{backend.settings.lowstate_loss_s * 1e3:.0f} ms, {backend._link.where()})"
-                    )
-                elif state == "streaming" and idle > backend.settings.deadman_s:
-                    reason = (
-                        f"deadman: send() not called for {idle * 1e3:.0f} ms (limit "
-                        f"{backend.settings.deadman_s * 1e3:.0f} ms): the sequencer stalled"
-                    )
-                elif state == "holding" and t >= next_hold:
-                    backend._publish(backend._last_q, 1.0, phase="hold")
-                    next_hold = max(next_hold + CONTROL_DT, t)  # no burst after a late wake-up
+            vitals = self._target.vitals()
+            if vitals.state not in ACTIVE:
+                return  # closing or already released: nothing left to watch
+            reason = fault_reason(vitals, self._loss_s, self._deadman_s)
             if reason is not None:
-                if backend.fault(reason):
-                    try:
-                        backend.release(reason)
-                    except Exception:
-                        log.exception("release after fault failed")
+                self._target.fail(reason)
                 return
+            t = self._now()
+            if vitals.state is ArmState.HOLDING and t >= next_hold:
+                self._target.hold()
+                next_hold = max(next_hold + CONTROL_DT, t)  # no burst after a late wake-up

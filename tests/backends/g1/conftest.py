@@ -48,7 +48,7 @@ class FakeRobot:
         cmd = [
             sys.executable,
             "-m",
-            "emopose.backends.g1.fake_robot",
+            "emopose.testing.fake_robot",
             "--domain-id",
             str(domain_id),
             "--log",

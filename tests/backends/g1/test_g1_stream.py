@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from emopose.backends.g1 import G1Backend, G1BackendError, profiles
-from emopose.backends.g1.fake_robot import DEFAULT_ARM_POSE
 from emopose.clock import MonotonicClock
 from emopose.recording import Recorder, read_recording
+from emopose.testing.fake_robot import DEFAULT_ARM_POSE
 
 RAMP_UP_S, RAMP_DOWN_S, BLEND_S = 0.4, 0.6, 0.3
 pytestmark = (

@@ -1,12 +1,13 @@
 """A fake G1 on DDS for tests and benchmarks, run as its own process:
 
-    python -m emopose.backends.g1.fake_robot [--domain-id N] [--duration S] [--log FILE.jsonl]
+    python -m emopose.testing.fake_robot [--domain-id N] [--duration S] [--log FILE.jsonl]
 
 Publishes rt/lowstate (500 Hz, valid CRC); takes rt/arm_sdk, ignores (and counts) commands with a
 bad CRC, and moves each commanded arm joint toward  w * q_cmd + (1 - w) * q_firmware  with a
 first-order lag (tau 0.05 s), w = motor_cmd[29].q (w = 0: the firmware holds its own pose).
 Answers the loco RPCs (see fake_loco.py). --log writes one JSON line per received arm command
-(q, weight, modes, gains, crc_ok), per loco request, and a final summary. Prints READY when up.
+(q, weight, modes, gains, crc_ok; t when taken, sent_ns when the sender wrote it: the
+batch-free send time), per loco request, and a final summary. Prints READY when up.
 """
 
 from __future__ import annotations
@@ -21,13 +22,13 @@ import time
 
 import numpy as np
 
-from emopose.backends.g1 import wire
+import emopose.backends.g1.wire as wire
 from emopose.backends.g1.arm_command import decode_arm_command
 from emopose.backends.g1.constants import LOCO_SERVICE, TOPIC_ARM_SDK, TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession, queue_qos
-from emopose.backends.g1.fake_loco import FakeLoco
 from emopose.backends.g1.hg_types import LowCmd_, LowState_
 from emopose.robot.g1_spec import NUM_MOTORS, WEIGHT_MOTOR
+from emopose.testing.fake_loco import FakeLoco
 
 DEFAULT_ARM_POSE = [0.3, 0.25, 0.0, 0.9, 0.0, 0.1, 0.0, 0.3, -0.25, 0.0, 0.9, 0.0, 0.1, 0.0]
 _SDK_MOTORS = slice(12, 29)  # waist + arms: what arm_sdk may command
@@ -71,17 +72,18 @@ class FakeG1:
     def _take_commands(self) -> None:
         while not self._stop.is_set():
             try:
-                samples = self._cmd_reader.take(timeout_s=0.05)
+                samples = self._cmd_reader.take_stamped(timeout_s=0.05)
             except Exception:  # noqa: BLE001 - the session was closed under us: just stop
                 return
-            for data in samples:
+            for data, sent_ns in samples:
                 record = wire.lowcmd_from_cdr(data)
                 if record is None:
                     self.undecodable += 1
                     continue
                 ok = wire.crc_ok(record)
                 if self._log_file is not None:
-                    self.log({"kind": "arm", "t": time.monotonic(), **decode_arm_command(record)})
+                    self.log({"kind": "arm", "t": time.monotonic(), "sent_ns": sent_ns,
+                              **decode_arm_command(record)})
                 if not ok:
                     self.bad_crc += 1  # the firmware drops it; so do we
                     continue
@@ -161,7 +163,7 @@ class FakeG1:
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p = argparse.ArgumentParser(
-        prog="python -m emopose.backends.g1.fake_robot", description=__doc__.split("\n")[0]
+        prog="python -m emopose.testing.fake_robot", description=__doc__.split("\n")[0]
     )
     p.add_argument("--domain-id", type=int, default=0)
     p.add_argument(
