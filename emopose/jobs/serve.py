@@ -1,8 +1,9 @@
 """+experiment=serve: the web UI on a live robot (chat, simulation view, Pose Studio).
 
 The control loop runs on its own thread in real time for as long as the server runs; turns are
-planned on a worker thread. uvicorn owns the main thread until Ctrl-C, then everything is released
-(the session's close() stops the loop and the backend). Settings are validated when the job is built, so
+planned on a worker thread. uvicorn owns the main thread until Ctrl-C or SIGTERM (it shuts down
+gracefully on both; see emopose/stop_signals.py), then everything is released (the session's close()
+stops the loop and the backend) and the results are written. Settings are validated when the job is built, so
 a bad serve.* value (say, a network bind without a token) stops before anything starts.
 """
 
@@ -26,7 +27,7 @@ class ServeJob:
     render: bool = True  # false: no MuJoCo frames anywhere (stick figure only)
 
     def __post_init__(self) -> None:
-        self.settings = ServeSettings.model_validate(self.serve)
+        self.settings = ServeSettings.from_config(self.serve)
 
     def __call__(self, run: Run) -> dict:
         res = run.resources

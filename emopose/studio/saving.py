@@ -67,7 +67,7 @@ def save_motion(studio: PoseStudio, raw: dict, overwrite: bool = False) -> SaveR
     if replaced and name == library.neutral and raw.get("class") != "neutral":
         raise SaveRefused(f"{name!r} is the neutral rest pose; it must stay class neutral")
     try:
-        entry = library.validate(raw, source=f"motion {name!r}")
+        entry = library.validate(raw, source="Pose Studio")
     except LibraryError as exc:
         raise SaveRefused(str(exc)) from exc
     problems = studio.report(entry).problems

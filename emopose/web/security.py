@@ -5,8 +5,12 @@ One pure-ASGI middleware, so HTTP and WebSocket get the same checks before any r
   the emopose_token cookie, or ?token= once: a valid query token is turned into an HttpOnly cookie
   so the page's scripts, images, audio and WebSocket carry it without putting it in URLs);
 - Host: on a loopback bind only loopback Host headers are served, which defeats DNS rebinding;
-- Origin: a browser request from another origin is refused (cross-site WebSocket hijacking and
-  form posts: WebSockets are not covered by CORS);
+- Origin: a request that carries an Origin header must come from the server's own origin
+  (scheme http/https, host and port equal to the Host header); anything else is refused, including
+  the opaque origin "null" that sandboxed iframes, data: URLs and file: pages send. This stops
+  cross-site WebSocket hijacking (WebSockets are not covered by CORS) and cross-site posts: browsers
+  always send Origin on WebSocket handshakes and POSTs. A request without Origin (curl, scripts, a
+  typed-in URL) is not a cross-site browser request and passes (the token, when set, still applies);
 - body: JSON only on /api posts (no CSRF "simple requests"), at most serve.max_body_bytes.
 """
 
@@ -31,6 +35,15 @@ BODY_METHODS = {"POST", "PUT", "PATCH", "DELETE"}
 def host_name(netloc: str) -> str:
     """'127.0.0.1:8765' -> '127.0.0.1', '[::1]:80' -> '::1'."""
     return (urlsplit(f"//{netloc}").hostname or "").lower()
+
+
+def same_origin(origin: str, host: str) -> bool:
+    """Whether a browser's Origin header names the server reached through `host` (its Host header).
+
+    "null" (a sandboxed iframe, a data: or file: page) is never the server's own origin."""
+    parts = urlsplit(origin.strip())
+    return (parts.scheme in ("http", "https") and bool(parts.netloc) and not parts.path
+            and parts.netloc.lower() == host.strip().lower())
 
 
 class _Refused(Exception):
@@ -84,8 +97,9 @@ class Guard:
 
     def _check_origin(self, headers: Headers) -> None:
         origin = headers.get("origin")
-        if origin and origin != "null" and urlsplit(origin).netloc.lower() != headers.get("host", "").lower():
-            raise _Refused(403, f"cross-origin request from {origin[:100]} refused")
+        if origin is not None and not same_origin(origin, headers.get("host", "")):
+            raise _Refused(403, f"cross-origin request from {origin[:100]!r} refused: only pages served "
+                                "by this server may call it")
 
     async def _checked_body(self, scope: Scope, headers: Headers, receive: Receive) -> Receive:
         if scope["method"] not in BODY_METHODS:

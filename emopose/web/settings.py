@@ -11,7 +11,7 @@ import ipaddress
 import re
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 MIN_TOKEN_CHARS = 16
 TOKEN_RE = re.compile(rf"[A-Za-z0-9._~-]{{{MIN_TOKEN_CHARS},256}}")
@@ -62,6 +62,21 @@ class ServeSettings(BaseModel):
                              "(letters, digits, - _ . ~), e.g. python -c 'import secrets; print(secrets.token_urlsafe())'")
         return self
 
+    @classmethod
+    def from_config(cls, serve: dict) -> ServeSettings:
+        """The `serve:` block validated; a bad value is a ValueError that names the key and what to do."""
+        try:
+            return cls.model_validate(serve)
+        except ValidationError as exc:
+            raise ValueError("; ".join(_problem(e) for e in exc.errors())) from None
+
     @property
     def local_only(self) -> bool:
         return is_loopback(self.host)
+
+
+def _problem(error: dict) -> str:
+    """One pydantic error as a person reads it: 'serve.port: ...', or a model check's own message."""
+    where = ".".join(map(str, error["loc"]))
+    message = error["msg"].removeprefix("Value error, ")
+    return f"serve.{where}: {message}" if where else message

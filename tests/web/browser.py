@@ -15,7 +15,7 @@ import subprocess
 import sys
 import time
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -35,9 +35,14 @@ def get_json(url: str) -> dict:
 
 
 @contextlib.contextmanager
-def served(root: Path, *overrides: str) -> Iterator[dict]:
-    """The CLI serving in root (its log in root/server.log); a graceful stop must write results.json."""
+def served(root: Path, *overrides: str, stop: signal.Signals = signal.SIGINT, record: bool = False,
+           prepare: Callable[[Path], object] | None = None) -> Iterator[dict]:
+    """The CLI serving in root (its log in root/server.log); a graceful stop (`stop`: Ctrl-C's SIGINT, or
+    SIGTERM as systemd and docker send it) must write results.json. `prepare(library folder)` runs before
+    the server starts (extra motion files). The yielded dict's "process" is the server's Popen."""
     library = copy_library(root)
+    if prepare is not None:
+        prepare(library)
     port = free_port()
     base = f"http://127.0.0.1:{port}"
     # No provider key: every endpoint a test names is a local stub, which must work keyless.
@@ -45,13 +50,13 @@ def served(root: Path, *overrides: str) -> Iterator[dict]:
     with open(root / "server.log", "w") as log:
         process = subprocess.Popen(
             [sys.executable, "-m", "emopose", "+experiment=serve", "planner=keyword", f"serve.port={port}",
-             "run.record=false", f"hydra.run.dir={root}/run", *library_overrides(library), *overrides],
+             f"run.record={str(record).lower()}", f"hydra.run.dir={root}/run", *library_overrides(library), *overrides],
             stdout=log, stderr=subprocess.STDOUT, env=env)
         try:
             _wait_until_up(process, base, root)
-            yield {"base": base, "library": library, "root": root}
+            yield {"base": base, "library": library, "root": root, "run": root / "run", "process": process}
         finally:
-            process.send_signal(signal.SIGINT)  # a graceful stop: the job writes results.json
+            process.send_signal(stop)  # a graceful stop: the job writes results.json
             try:
                 process.wait(timeout=20)
             except subprocess.TimeoutExpired:
@@ -87,9 +92,9 @@ def chromium():
 
 
 @contextlib.contextmanager
-def watched_page(browser, base: str):
+def watched_page(browser, base: str, width: int = 1400, height: int = 900):
     """A fresh page that must fetch nothing from outside the server and raise no JavaScript error."""
-    context = browser.new_context(viewport={"width": 1400, "height": 900})
+    context = browser.new_context(viewport={"width": width, "height": height})
     page = context.new_page()
     foreign, errors = [], []
     page.on("request", lambda r: None if r.url.startswith((base, "data:", "blob:")) else foreign.append(r.url))

@@ -101,8 +101,12 @@ def test_studio_variant_is_saved_and_the_next_message_resolves_to_it(page, serve
     page.click("#save")
     expect(page.locator("#save-result")).to_contain_text(f"saved {name}", timeout=10_000)
     assert (server["library"] / f"{name}.yaml").is_file()
-    page.click("#perform")
-    expect(page.locator("#perform-result")).to_contain_text(f"→ {name} (exact)", timeout=10_000)
+    page.click("#perform")  # the draft on screen, which is now also the saved motion
+    expect(page.locator("#perform-result")).to_contain_text("performing the draft on screen", timeout=10_000)
+    expect(page.locator("#name-hint")).to_contain_text("replace the existing motion")  # saving again needs the box
+    expect(page.locator("#save")).to_be_disabled()
+    page.check("#overwrite")
+    expect(page.locator("#save")).to_be_enabled()
     SHOTS.mkdir(exist_ok=True)
     page.screenshot(path=str(SHOTS / f"studio_{server['backend']}.png"), full_page=True)
 
