@@ -15,7 +15,10 @@ CLASSES: tuple[str, ...] = (
     "comforting",
     "neutral",
 )
+# A gesture's stroke has arrived when every joint is within this many rad of its stroke-start keyframe:
+# where the timeline aims, what the sequencer reports as "stroke" and what sync_eval measures.
+STROKE_TOLERANCE = 0.05
 # Re-exported so `from emopose import CONTROL_DT` keeps working; the G1 spec module owns them.
 from emopose.robot.g1_spec import CONTROL_DT, CONTROL_HZ, NUM_JOINTS  # noqa: E402
 
-__all__ = ["CLASSES", "CONTROL_DT", "CONTROL_HZ", "NUM_JOINTS"]
+__all__ = ["CLASSES", "CONTROL_DT", "CONTROL_HZ", "NUM_JOINTS", "STROKE_TOLERANCE"]

@@ -24,6 +24,7 @@ from emopose.resources import Resources, Run
 from emopose.runner import TurnRunner
 from emopose.session import Session
 from emopose.speech.player import Player
+from emopose.sync_record import event_writer
 from emopose.tour.scene_view import SceneSlot
 from emopose.trajectory import TrajectoryBuilder
 
@@ -122,6 +123,7 @@ def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
                           sequencer=sequencer, clock=clock, synthesizer=synthesizer, player=player,
                           asr=make(cfg.get("asr"), "asr"), scene=scene, run_dir=Path(run_dir))
     session = Session(backend, loop, library.neutral_entry.q[0], run_dir, record=bool(cfg.run.record))
+    sequencer.on_event = event_writer(loop, session.write)
     thinking = make_with(cfg.get("thinking"), "thinking", shared)
     return Run(resources, session, TurnRunner(planner, pipeline, session, thinking))
 

@@ -6,17 +6,24 @@ The model never supplies a joint value: `LibraryEntry.keyframes` only ever come 
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, create_model, field_validator, model_validator
 
 from emopose import CLASSES, NUM_JOINTS
 
 GestureClass = Literal[
     "pointing", "emphasizing", "rejecting", "agreeing", "doubting", "welcoming", "comforting", "neutral"
 ]
-PlanSource = Literal["model", "plain_text", "keyword_fallback", "empty", "scripted"]  # scripted: no planner
+# Where a plan's records came from. Usable: the model's own records (first try, or after transient
+# retries), or a script (no planner). Every other source is a fallback the benchmarks count: chatter
+# (plain_text), nothing (empty), a class outside the eight (unknown_class), no records (no_records),
+# JSON no parser could use (keyword_fallback), or no answer at all (call_failed: the call failed for good).
+PlanSource = Literal["model", "retried", "scripted", "plain_text", "empty", "unknown_class", "no_records",
+                     "keyword_fallback", "call_failed"]
+USABLE_SOURCES = frozenset({"model", "retried", "scripted"})
 
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
 
@@ -47,6 +54,11 @@ class Plan(BaseModel):
     notes: tuple[str, ...] = ()
 
     @property
+    def fallback(self) -> bool:
+        """True when the records are not a usable model (or scripted) record."""
+        return self.source not in USABLE_SOURCES
+
+    @property
     def top_class(self) -> str:
         return self.records[0].cls if self.records else "neutral"
 
@@ -54,6 +66,22 @@ class Plan(BaseModel):
     def scripted(cls, reply: str, *records: GestureRecord) -> Plan:
         """A plan written by code (a suite item, a robot check, a button), not by a planner."""
         return cls(reply=reply, records=records, source="scripted")
+
+
+def plan_schema(variants: Sequence[str], max_gestures: int) -> dict:
+    """The JSON schema of a planner's answer, generated from GestureRecord: the eight classes, the live
+    library's variant names as an enum, every field required and nothing else allowed (what OpenAI's
+    strict structured output and llama.cpp's grammar both accept)."""
+    if not variants:
+        raise ValueError("plan_schema needs at least one library variant")
+    strict = ConfigDict(extra="forbid", populate_by_name=True)
+    record = create_model(
+        "GestureRecord", __config__=strict, __doc__=GestureRecord.__doc__,
+        cls=(GestureClass, Field(alias="class")), variant=(Literal[tuple(variants)], ...),
+        intensity=(int, Field(ge=1, le=5)), trigger=(str, ...), confidence=(float, Field(ge=0.0, le=1.0)))
+    answer = create_model("GesturePlan", __config__=strict, reply=(str, ...),
+                          gestures=(list[record], Field(min_length=1, max_length=max_gestures)))
+    return answer.model_json_schema(by_alias=True)
 
 
 MotionType = Literal["sequence", "pose"]
@@ -70,6 +98,9 @@ class LibraryEntry(BaseModel):
     motion_type: MotionType = "sequence"
     duration: float | None = Field(default=None, gt=0.0, le=20.0)
     keyframes: tuple[tuple[float, ...], ...]
+    # Sync points (BML's stroke_start, stroke_end) as keyframe indices: where the expressive part of the
+    # motion begins and ends. The timeline puts the stroke start on the trigger word.
+    stroke: tuple[int, int] | None = None
     _q: np.ndarray = PrivateAttr()
 
     @field_validator("keyframes")
@@ -93,12 +124,29 @@ class LibraryEntry(BaseModel):
             )
         self._q = np.asarray(self.keyframes, dtype=float)
         self._q.setflags(write=False)
+        if self.stroke is not None:
+            start, end = self.stroke
+            first, last = (0, 0) if self.motion_type == "pose" else (1, k - 2)
+            if not first <= start <= end <= last:
+                raise ValueError(f"stroke {list(self.stroke)} must satisfy {first} <= start <= end <= {last} "
+                                 f"(interior keyframe indices of this {self.motion_type})")
         return self
 
     @property
     def q(self) -> np.ndarray:
         """Keyframes as a read-only (K, 14) array in radians."""
         return self._q
+
+    @property
+    def stroke_span(self) -> tuple[int, int]:
+        """The declared stroke, else the documented default: the interior keyframe of largest excursion
+        from the first (max over joints), as a single apex."""
+        if self.stroke is not None:
+            return self.stroke
+        if self.motion_type == "pose":
+            return (0, 0)
+        apex = 1 + int(np.argmax(np.abs(self._q[1:-1] - self._q[0]).max(axis=1)))
+        return (apex, apex)
 
     @property
     def default_duration(self) -> float:

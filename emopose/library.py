@@ -8,6 +8,7 @@ so planners regenerate their guide and the resolver sees new variants without a 
 
 from __future__ import annotations
 
+import logging
 import os
 import shutil
 import tempfile
@@ -22,6 +23,7 @@ from pydantic import ValidationError
 from emopose import CLASSES, NUM_JOINTS
 from emopose.contract import LibraryEntry
 
+log = logging.getLogger(__name__)
 
 class LibraryError(ValueError):
     """A library file or library configuration is invalid; the message says where and how to fix it."""
@@ -57,11 +59,25 @@ class JointLimits:
         """Pi_j: clip into [q- + margin, q+ - margin] joint-wise; works on (14,) or (T, 14)."""
         return np.clip(q, self.lower + margin, self.upper - margin)
 
+    def _outside(self, q: np.ndarray, margin: float) -> np.ndarray:
+        """(T, 14) mask: where q leaves [q- + margin, q+ - margin]."""
+        return (q < self.lower + margin) | (q > self.upper - margin)
+
     def violations(self, q: np.ndarray, margin: float = 0.0) -> list[str]:
         """Names of joints that leave [q- + margin, q+ - margin] anywhere in q ((14,) or (T, 14))."""
-        q = np.atleast_2d(q)
-        bad = np.any((q < self.lower + margin) | (q > self.upper - margin), axis=0)
+        bad = np.any(self._outside(np.atleast_2d(q), margin), axis=0)
         return [self.names[j] for j in np.flatnonzero(bad)]
+
+    def violation_details(self, q: np.ndarray, margin: float = 0.0) -> list[str]:
+        """One line per offending joint of (K, 14) keyframes: its worst keyframe, value and allowed range."""
+        q = np.atleast_2d(q)
+        low, high = self.lower + margin, self.upper - margin
+        excess = np.maximum(low - q, q - high)  # > 0 outside
+        out = []
+        for j in np.flatnonzero(np.any(self._outside(q, margin), axis=0)):
+            k = int(np.argmax(excess[:, j]))
+            out.append(f"{self.names[j]} = {q[k, j]:.3f} rad in keyframe {k} (allowed {low[j]:.3f}..{high[j]:.3f})")
+        return out
 
 
 @dataclass(frozen=True)
@@ -171,7 +187,11 @@ class MotionLibrary:
             raw = yaml.safe_load(path.read_text())
         except (OSError, yaml.YAMLError) as exc:
             raise LibraryError(f"{path}: not readable YAML ({exc})") from exc
-        return self.validate(raw, source=str(path))
+        entry = self.validate(raw, source=str(path))
+        if entry.stroke is None and entry.motion_type == "sequence":
+            log.warning("%s: no `stroke: [start, end]`; using the largest-excursion keyframe %s as the stroke",
+                        path, list(entry.stroke_span))
+        return entry
 
     def validate(self, raw: object, source: str) -> LibraryEntry:
         """Validate one motion (a mapping as in a library file) against the schema and the joint limits."""
@@ -183,11 +203,11 @@ class MotionLibrary:
             name = raw.get("name", "?")
             problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'entry'}: {e['msg']}" for e in exc.errors())
             raise LibraryError(f"{source}: motion '{name}': {problems}") from exc
-        bad = self.limits.violations(entry.q, self.limit_margin)
+        bad = self.limits.violation_details(entry.q, self.limit_margin)
         if bad:
             raise LibraryError(
-                f"{source}: motion '{entry.name}': keyframes leave the joint limits "
-                f"(margin {self.limit_margin} rad) for {bad}; see {self.limits.names[0]}... in limits.yaml"
+                f"{source}: motion '{entry.name}': keyframes leave the joint limits (kept {self.limit_margin} rad "
+                f"inside the limits file's range): {'; '.join(bad)}"
             )
         return entry
 

@@ -17,8 +17,9 @@ from emopose.contract import Plan
 from emopose.pipeline import Pipeline, PipelineError, Stage
 from emopose.planners.base import Planner, PlanRequest
 from emopose.session import Session
+from emopose.sync_record import TIMELINE, speech_timeline
 from emopose.thinking import ThinkingGesture
-from emopose.turn import Turn
+from emopose.turn import ResolvedGesture, Turn
 
 
 @dataclass
@@ -53,15 +54,21 @@ class TurnRunner:
                                  {"role": "assistant", "content": turn.plan.reply}])
         return turn
 
-    def run_plan(self, plan: Plan, utterance: str | None = None) -> Turn:
-        """Execute a scripted plan from the first stage that reads it; it stays out of the history."""
+    def run_plan(self, plan: Plan, utterance: str | None = None,
+                 resolved: list[ResolvedGesture] | None = None) -> Turn:
+        """Execute a scripted plan from the first stage that reads it; it stays out of the history.
+
+        With `resolved` (motions in no library: a Pose Studio draft) it enters at the first stage that
+        reads those, so everything after resolution (modulation, limits, the sequencer's checks) applies."""
         self.session.open()
-        turn = Turn(PlanRequest(utterance=plan.reply if utterance is None else utterance), plan=plan)
-        self._record(turn, "request")
-        self._record(turn, "plan")
-        start = next((s.name for s in self.pipeline.stages if "plan" in s.reads), None)
+        turn = Turn(PlanRequest(utterance=plan.reply if utterance is None else utterance), plan=plan,
+                    resolved=resolved)
+        entry = "plan" if resolved is None else "resolved"
+        for name in ("request", "plan") if resolved is None else ("request", "plan", "resolved"):
+            self._record(turn, name)
+        start = next((s.name for s in self.pipeline.stages if entry in s.reads), None)
         if start is None:
-            raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} reads it")
+            raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} reads {entry}")
         self._recorded.run(turn, start)
         return turn
 
@@ -75,6 +82,8 @@ class TurnRunner:
     def _recording_hook(self, stage: Stage, turn: Turn) -> None:
         for name in stage.writes:
             self._record(turn, name)
+        if "dispatched" in stage.writes and self.session.recording:  # enough to re-measure the sync
+            self.session.write(TIMELINE, speech_timeline(turn, self.session.loop))
 
     def _record(self, turn: Turn, name: str) -> None:
         if not self.session.recording:

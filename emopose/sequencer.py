@@ -13,6 +13,13 @@ successor begins on its word.
 `step(now)` is called once per 50 Hz tick and returns the 14-DoF target to publish; every transition
 starts from the latest published pose, so the stream never jumps. submit/interrupt are thread-safe.
 Time is whatever `now` the caller passes: tests drive it with a fake clock.
+
+Timed commands (the stroke-synchronous timeline, emopose/timeline.py) carry every keyframe's time: one
+starts at its release time from the pose published then (no blend in front: its first segment is its
+own transition), preempting ("cut") a motion still running, and its trajectory meets the keyframe
+times, lengthening only what the speed bound forbids. Events: started, stroke (the arm within
+STROKE_TOLERANCE of the stroke-start keyframe), completed, cut (ended after its stroke, co-articulated or preempted), stopped,
+rejected, dropped (by the timeline, with its reason), state.
 """
 
 from __future__ import annotations
@@ -27,6 +34,8 @@ from enum import StrEnum
 
 import numpy as np
 
+from emopose import STROKE_TOLERANCE
+from emopose.bounded_log import BoundedLog
 from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 
@@ -39,7 +48,8 @@ class State(StrEnum):
 
 @dataclass(frozen=True)
 class GestureCommand:
-    """A motion to run: intensity-modulated (K, 14) keyframes, duration, earliest start (clock time)."""
+    """A motion to run: intensity-modulated (K, 14) keyframes, duration, earliest start (clock time).
+    A timed command also gives each keyframe's time after release_at (`offsets`, offsets[0] = 0)."""
 
     name: str
     keyframes: np.ndarray
@@ -47,12 +57,21 @@ class GestureCommand:
     release_at: float = float("-inf")
     label: str = ""
     id: int = field(default_factory=itertools.count().__next__)
+    record: int | None = None               # index of the plan record it performs, when it comes from a turn
+    stroke: tuple[int, int] | None = None   # keyframe indices of the stroke, for the "stroke" event
+    offsets: tuple[float, ...] | None = None
+    blend_in: bool = False                  # timed: the first segment is a co-articulation blend
+    cut: bool = False                       # timed: planned to end after its stroke (reported as "cut")
+
+    @property
+    def timed(self) -> bool:
+        return self.offsets is not None
 
 
 @dataclass(frozen=True)
 class Event:
     t: float
-    kind: str  # started, completed, stopped, rejected, state
+    kind: str  # started, stroke, completed, cut, stopped, rejected, dropped, state
     name: str = ""
     command_id: int | None = None
     detail: str = ""
@@ -74,6 +93,7 @@ class Sequencer:
         neutral_tolerance: float = 0.02,
         preempt_after_s: float | None = None,
         on_event: Callable[[Event], None] | None = None,
+        keep_events: int = 10_000,
     ) -> None:
         self.builder = builder
         self.neutral = np.asarray(neutral, dtype=float)
@@ -83,8 +103,8 @@ class Sequencer:
         self.neutral_tolerance = neutral_tolerance
         self.preempt_after_s = preempt_after_s
         self.on_event = on_event
-        self.events: list[Event] = []
-        self.construction_s: list[float] = []
+        self.events: BoundedLog[Event] = BoundedLog(keep_events)
+        self.construction_s: BoundedLog[float] = BoundedLog(keep_events)
         self._lock = threading.RLock()
         self._queue: deque[GestureCommand] = deque()
         self.reset(self.neutral, 0.0)
@@ -99,21 +119,30 @@ class Sequencer:
             self._index = 0
             self._active: GestureCommand | None = None
             self._after_blend: GestureCommand | None = None
+            self._stroke_tick = -1
             self._hold_since = now
 
     def submit(self, command: GestureCommand) -> None:
         with self._lock:
             self._queue.append(command)
 
+    def drop(self, command: GestureCommand, reason: str, now: float) -> None:
+        """Record a gesture the timeline could not fit (it is never queued)."""
+        with self._lock:
+            self._emit(now, "dropped", command, reason)
+
     def interrupt(self, commands: list[GestureCommand] | tuple = (), now: float | None = None) -> None:
-        """Clear pending actions; blend from the latest published pose to the first new command (or neutral)."""
+        """Clear pending actions; blend from the latest published pose to the first new command (or neutral).
+        A timeline (timed commands) is queued whole: the arm heads for rest until its first gesture's
+        start, which then prepares from wherever the arm is."""
         with self._lock:
             now = self._hold_since if now is None else now
             if self._active is not None:
                 self._emit(now, "stopped", self._active)
             self._queue.clear()
-            self._queue.extend(commands[1:])
-            if commands:
+            timed = bool(commands) and commands[0].timed
+            self._queue.extend(commands if timed else commands[1:])
+            if commands and not timed:
                 first = commands[0]
                 self._start_blend(now, np.asarray(first.keyframes[0]), self.interrupt_blend_s, first)
             else:
@@ -149,6 +178,10 @@ class Sequencer:
         with self._lock:
             if self.state in (State.EXECUTING, State.BLENDING):
                 self._advance(now)
+            if self.state == State.EXECUTING and self._timed_head_due(now):
+                self._emit(now, "cut", self._active, "preempted at the next gesture's timeline start")
+                self._active = None
+                self._begin_or_hold(self._queue.popleft(), now)
             if self.state == State.EXECUTING and self._overdue(now):
                 self._emit(now, "stopped", self._active, "preempted by an overdue successor")
                 head = self._queue.popleft()
@@ -163,23 +196,31 @@ class Sequencer:
     def _advance(self, now: float) -> None:
         self._index += 1
         self.last = self._motion.samples[self._index].copy()
+        if self._index == self._stroke_tick and self.state == State.EXECUTING:
+            self._emit(now, "stroke", self._active)
         if self._index < len(self._motion.samples) - 1:
             return
         if self.state == State.EXECUTING:
-            self._emit(now, "completed", self._active)
+            done = self._active
+            self._emit(now, *(("cut", done, "co-articulated into the next gesture") if done.cut else ("completed", done)))
             self._active = None
             head = self._queue[0] if self._queue else None
             if head is not None and head.release_at <= now:
                 self._queue.popleft()
-                self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
+                if head.timed:
+                    self._begin_or_hold(head, now)
+                else:
+                    self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
             else:
                 self._set_state(now, State.HOLDING)
         elif self._after_blend is not None:
             command, self._after_blend = self._after_blend, None
-            if not self._begin(command, now):
-                self._set_state(now, State.HOLDING)
+            self._begin_or_hold(command, now)
         else:
             self._set_state(now, State.IDLE)
+
+    def _timed_head_due(self, now: float) -> bool:
+        return bool(self._queue) and self._queue[0].timed and self._queue[0].release_at <= now
 
     def _overdue(self, now: float) -> bool:
         return (self.preempt_after_s is not None and bool(self._queue)
@@ -195,16 +236,39 @@ class Sequencer:
 
     def _begin(self, command: GestureCommand, now: float) -> bool:
         started = time.perf_counter()
-        motion = self.builder.build(command.keyframes, command.duration, self.last)
+        if command.timed:
+            times = np.asarray(command.offsets[1:]) + (command.release_at - now)
+            motion = self.builder.build_timed(command.keyframes, times, self.last, command.blend_in)
+        else:
+            motion = self.builder.build(command.keyframes, command.duration, self.last)
         self.construction_s.append(time.perf_counter() - started)
         reason = self.safety(motion.samples) if self.safety else None
         if reason is not None:
             self._emit(now, "rejected", command, reason)
             return False
         self._motion, self._index, self._active = motion, 0, command
+        self._stroke_tick = self._arrival_tick(motion, command)
         self._set_state(now, State.EXECUTING)
-        self._emit(now, "started", command, f"stretch={motion.stretch:.2f}" if motion.stretch > 1 else "")
+        detail = (f"late={motion.late_s * 1e3:.0f}ms" if motion.late_s > 0.01
+                  else f"stretch={motion.stretch:.2f}" if motion.stretch > 1 else "")
+        self._emit(now, "started", command, detail)
         return True
+
+    @staticmethod
+    def _arrival_tick(motion: Trajectory, command: GestureCommand) -> int:
+        """The sample at which the stroke arrives (within STROKE_TOLERANCE of its start keyframe, on
+        the way there), or -1 without a declared stroke."""
+        if command.stroke is None:
+            return -1
+        start = command.stroke[0]
+        keyframe = np.asarray(command.keyframes)[start]
+        reached = motion.anchor_ticks[max(start, 1)]
+        close = np.max(np.abs(motion.samples[1:reached + 1] - keyframe), axis=1) <= STROKE_TOLERANCE
+        return 1 + int(np.argmax(close)) if close.any() else reached
+
+    def _begin_or_hold(self, command: GestureCommand, now: float) -> None:
+        if not self._begin(command, now):
+            self._set_state(now, State.HOLDING)
 
     def _start_blend(self, now: float, target: np.ndarray, duration: float, then: GestureCommand | None) -> None:
         self._motion = self.builder.blend(self.last, target, duration)

@@ -9,6 +9,10 @@ A pose (one keyframe) is a single segment from q_last to the pose.
 Beyond the paper: if a sample step would exceed the joint speed bound (for example an intensity-5
 excursion, or a start far from the first keyframe), the whole trajectory is slowed down uniformly
 until it does not; `stretch` reports the factor. Blends get the same treatment.
+
+Timed construction (the timeline): each keyframe has its own time, so segments differ in length; a
+segment too short for the speed bound is lengthened and everything after it moves later (`late_s`).
+The first segment of a co-articulated gesture eases with the cubic blend beta instead of the smoothstep.
 """
 
 from __future__ import annotations
@@ -40,6 +44,8 @@ class Trajectory:
     samples: np.ndarray
     dt: float
     stretch: float = 1.0
+    anchor_ticks: tuple[int, ...] = ()  # sample index at which each keyframe is reached (0: the start pose)
+    late_s: float = 0.0  # timed builds: how much later than asked the last keyframe is reached
 
     @property
     def duration(self) -> float:
@@ -96,7 +102,45 @@ class TrajectoryBuilder:
         np.maximum(samples, self.limits.lower, out=samples)  # = limits.project, minus np.clip's overhead
         np.minimum(samples, self.limits.upper, out=samples)
         samples[0] = q_last
-        return Trajectory(samples, self.dt, stretch)
+        total = duration * stretch
+        ticks = tuple(self.tick(total * i / len(rest)) for i in range(len(rest) + 1))
+        return Trajectory(samples, self.dt, stretch, ticks)
+
+    def tick(self, t: float) -> int:
+        """The first sample index at or after time t."""
+        return max(0, math.ceil(t / self.dt - 1e-9))
+
+    def segment_minimum(self, q_from: np.ndarray, q_to: np.ndarray, blend: bool = False) -> float:
+        """Shortest duration (s) of one eased segment that keeps every joint within its speed bound."""
+        peak = 3.0 if blend else self._steepest * self.increments  # beta' peaks at 3; smoothstep waypoints ~1.48
+        return peak * float(np.max(np.abs(np.asarray(q_to) - np.asarray(q_from)) * self._inv_velocity))
+
+    def build_timed(self, keyframes: np.ndarray, times: np.ndarray, q_last: np.ndarray,
+                    blend_in: bool = False) -> Trajectory:
+        """Keyframes 1..n reached at `times` (s after the start, increasing); keyframe 0 is replaced by
+        q_last. Segments the speed bound forbids are lengthened, delaying the rest."""
+        anchors = np.array(keyframes, dtype=float, ndmin=2)
+        anchors[0] = q_last
+        wanted = np.asarray(times, dtype=float)
+        ends, t = np.empty(len(anchors) - 1), 0.0
+        for i in range(len(ends)):
+            shortest = max(self.segment_minimum(anchors[i], anchors[i + 1], blend_in and i == 0), self.dt)
+            t = max(wanted[i], t + shortest)
+            ends[i] = t
+        starts = np.concatenate([[0.0], ends[:-1]])
+        grid = np.arange(self.tick(ends[-1]) + 1) * self.dt
+        seg = np.minimum(np.searchsorted(ends, grid - 1e-12), len(ends) - 1)
+        u = np.clip((grid - starts[seg]) / (ends[seg] - starts[seg]), 0.0, 1.0)
+        knots = np.arange(self.increments + 1) / self.increments
+        weight = np.interp(u, knots, smoothstep(knots))
+        if blend_in:
+            first = seg == 0
+            weight[first] = blend_weight(u[first])
+        samples = anchors[seg] + weight[:, None] * (anchors[seg + 1] - anchors[seg])
+        samples = self.limits.project(samples)
+        samples[0] = q_last
+        ticks = (0, *(self.tick(e) for e in ends))
+        return Trajectory(samples, self.dt, 1.0, ticks, float(ends[-1] - wanted[-1]))
 
     def _weights(self, segments: int, duration: float) -> np.ndarray:
         """(N + 1, segments + 1) matrix taking the anchors to the 50 Hz samples, cached per (segments, d)."""

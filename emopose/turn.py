@@ -20,6 +20,7 @@ from emopose.speech.clip import SpeechClip
 
 ResolveRule = Literal["exact", "class_default", "neutral", "gated"]
 ReleaseRule = Literal["anchor", "words", "interpolated", "even", "immediate"]
+Fit = Literal["nominal", "scaled", "coarticulated", "shortened", "late"]
 
 
 @dataclass(frozen=True)
@@ -65,12 +66,37 @@ class ModulatedGesture:
 
 
 @dataclass(frozen=True)
+class GestureTiming:
+    """A gesture on the timeline, in s from the start of speech: keyframes[0..n] (n = len(times) - 1,
+    after any cut) are reached at `times`; keyframe 0 is the start pose, whatever is published then.
+    `stroke` holds keyframe indices; the stroke is aimed to arrive (come within the tolerance of the
+    stroke-start keyframe) at `target_s`, and is planned to arrive at `arrival_s`."""
+
+    keyframes: np.ndarray
+    times: tuple[float, ...]
+    stroke: tuple[int, int]
+    target_s: float
+    arrival_s: float
+    fit: Fit
+    blend_in: bool = False      # the first segment blends from the previous gesture's stroke (co-articulation)
+    scale: float = 1.0          # time scale of the preparation
+    cut: bool = False           # ends after its stroke: the next gesture co-articulates from there
+
+    def as_json(self) -> dict:
+        return {"times": [round(t, 4) for t in self.times], "stroke": list(self.stroke), "target_s": self.target_s,
+                "arrival_s": self.arrival_s, "fit": self.fit, "blend_in": self.blend_in, "scale": self.scale, "cut": self.cut}
+
+
+@dataclass(frozen=True)
 class Release:
-    """When gesture k is released, relative to the start of speech, and which rule placed it."""
+    """When gesture k is released, relative to the start of speech, and which rule placed it. A timeline
+    schedule adds the gesture's timing, or why it was dropped."""
 
     release_s: float
     how: ReleaseRule
     trigger_found: bool
+    timing: GestureTiming | None = None
+    dropped: str | None = None
 
 
 @dataclass(frozen=True)
@@ -78,6 +104,7 @@ class Schedule:
     reply: str
     releases: tuple[Release, ...]
     gestures: tuple[ModulatedGesture, ...]
+    preroll_s: float = 0.0  # speech starts this much after the first gesture may (timeline mode)
 
     @property
     def missing_triggers(self) -> list[int]:
@@ -85,22 +112,26 @@ class Schedule:
         return [k for k, r in enumerate(self.releases) if not r.trigger_found]
 
     def as_json(self) -> dict:
-        return {"releases": [{"name": g.name, "release_s": r.release_s, "how": r.how,
-                              "trigger_found": r.trigger_found} for g, r in zip(self.gestures, self.releases)]}
+        return {"preroll_s": self.preroll_s, "releases": [
+            {"name": g.name, "release_s": r.release_s, "how": r.how, "trigger_found": r.trigger_found,
+             "dropped": r.dropped, "timing": None if r.timing is None else r.timing.as_json()}
+            for g, r in zip(self.gestures, self.releases)]}
 
 
 @dataclass(frozen=True)
 class Submission:
-    """The commands handed to the sequencer, the planned speech start (control clock) and hand-off times."""
+    """The commands handed to the sequencer, the planned speech start (control clock), hand-off times, and
+    when dispatch should start the audio (after the timeline's pre-roll)."""
 
     commands: tuple[GestureCommand, ...]
     speech_start: float
     submission_s: tuple[float, ...]
+    play_at: float = float("-inf")
 
     def as_json(self) -> dict:
-        return {"speech_start": self.speech_start, "submission_s": list(self.submission_s),
-                "commands": [{"id": c.id, "name": c.name, "release_at": c.release_at, "duration_s": c.duration,
-                              "label": c.label} for c in self.commands]}
+        return {"speech_start": self.speech_start, "play_at": self.play_at, "submission_s": list(self.submission_s),
+                "commands": [{"id": c.id, "record": c.record, "name": c.name, "release_at": c.release_at,
+                              "duration_s": c.duration, "label": c.label} for c in self.commands]}
 
 
 @dataclass(frozen=True)

@@ -78,7 +78,7 @@ class SimSuiteJob:
         if start == "rest":
             loop.run_until(lambda: sequencer.state == State.IDLE, self.rest_timeout_s)
         q_start = sequencer.last.copy()
-        first_tick, first_build = len(tap), len(sequencer.construction_s)
+        first_tick, first_build = len(tap), sequencer.construction_s.total
         simulated = tap.backend if isinstance(tap.backend, SimulatedState) else None
         if simulated is not None:
             simulated.max_actuator_force_ratio = 0.0  # per-trial peak
@@ -91,7 +91,7 @@ class SimSuiteJob:
                "start_offset_rad": float(np.max(np.abs(q_start - command.keyframes[0]))),
                "completed": "completed" in kinds and not kinds & {"stopped", "rejected"} and report.completed,
                "stopped": "stopped" in kinds, "rejected": "rejected" in kinds, "timeout": not report.completed,
-               "construction_s": sequencer.construction_s[first_build:],
+               "construction_s": sequencer.construction_s.since(first_build),
                "submission_s": list(turn.submitted.submission_s)}
         row["force_ratio"] = simulated.max_actuator_force_ratio if simulated is not None else float("nan")
         started = next((e for e in mine if e.kind == "started"), None)

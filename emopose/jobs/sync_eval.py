@@ -9,6 +9,10 @@ every released gesture is compared with the onset espeak reports for its trigger
   actual vs onset:    the sequencer's "started" event (what the robot did): the 50 Hz tick grid adds
                       0..20 ms, and a gesture whose predecessor is still running waits for it to end
                       (plus the <= 0.3 s blend), which no schedule can undo.
+  stroke vs onset:    where the executed stroke lands (emopose.stroke_sync.py): the first tick
+                      at which the command stream, and with a simulator the joint stream, reaches the
+                      gesture's stroke-start keyframe; this is the measure the timeline mode is built for.
+A few items per mode are drawn as timelines (words, planned and executed strokes) into the run directory.
 """
 
 from __future__ import annotations
@@ -17,13 +21,18 @@ import logging
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from emopose.clock import FakeClock
 from emopose.jobs.report import markdown_table, write_results
 from emopose.jobs.sync_measure import GestureSync, SuiteItem, load_suite, measure_turn, summarize
+from emopose.jobs.sync_plot import plot_timelines
+from emopose.jobs.tracking import StreamTap
 from emopose.pipeline import Pipeline
 from emopose.resources import Resources, Run
 from emopose.runner import TurnRunner
 from emopose.speech.espeak import EspeakSynthesizer
+from emopose.stroke_sync import Streams, StrokeSync, measure_strokes, planned_strokes, stroke_summary
 
 log = logging.getLogger(__name__)
 
@@ -32,9 +41,10 @@ log = logging.getLogger(__name__)
 class SyncEvalJob:
     suite: str
     fallback_suite: str | None = None
-    modes: list[str] = field(default_factory=lambda: ["anchor", "words"])
+    modes: list[str] = field(default_factory=lambda: ["anchor", "words", "timeline"])
     limit: int | None = None
     target_p95_ms: float = 60.0  # words mode, scheduled vs onset
+    plots: int = 4               # items drawn as timelines per mode
 
     def __call__(self, run: Run) -> dict:
         res = run.resources
@@ -45,11 +55,19 @@ class SyncEvalJob:
             raise ValueError("sync_eval runs on virtual time: use backend=dry_run with run.clock=auto")
         suite_path, items = self._items()
         run.session.open()
+        tap = run.session.tap(StreamTap)
         rows: dict[str, list[GestureSync]] = {}
+        strokes: dict[str, list[StrokeSync]] = {}
         for mode in self.modes:
             runner = run.runner.with_pipeline(self._pipeline(res.pipeline, mode))
-            rows[mode] = [row for item in items for row in self._run_item(res, runner, item)]
-        results = self._results(run, suite_path, items, rows)
+            rows[mode], strokes[mode] = [], []
+            for number, item in enumerate(items):
+                sync, stroke, turn = self._run_item(res, runner, item, tap)
+                rows[mode] += sync
+                strokes[mode] += stroke
+                if number < self.plots:
+                    plot_timelines(res.run_dir / f"timeline_{mode}_{item.id}.png", item, turn, stroke)
+        results = self._results(run, suite_path, items, rows, strokes, simulated=tap.simulated)
         write_results(res.run_dir, results, self._markdown(results))
         print(self._markdown(results))
         return results
@@ -75,14 +93,29 @@ class SyncEvalJob:
                          replace(stages["sequence"], interrupt=False), replace(stages["dispatch"], until="rest")],
                         inputs=("request", "plan"))
 
-    def _run_item(self, res: Resources, runner: TurnRunner, item: SuiteItem) -> list[GestureSync]:
+    def _run_item(self, res: Resources, runner: TurnRunner, item: SuiteItem, tap: StreamTap):
+        first = len(tap)
         turn = runner.run_plan(item.plan(), utterance=item.text)
         if not turn.dispatched.completed:
             log.warning("item %s did not come to rest within the dispatch timeout", item.id)
-        return measure_turn(item, turn, res.synthesizer.word_events(item.text))
+        sync = measure_turn(item, turn, res.synthesizer.word_events(item.text))
+        loop = runner.session.loop
+        times = np.asarray(tap.times[first:]) + (loop.clock.now() - loop.stream_time)  # stream -> clock time
+        simulated = tap.simulated
+        streams = Streams([(e.t, e.kind, e.command_id) for e in turn.dispatched.events], turn.dispatched.speech_start,
+                          times, np.asarray(tap.commands[first:]), times + loop.dt if simulated else None,
+                          np.asarray(tap.states[first:]) if simulated else None)
+        strokes = measure_strokes(item.id, planned_strokes(turn), [r.onset_s for r in sync], streams,
+                                  turn.schedule.preroll_s)
+        return sync, strokes, turn
 
-    def _results(self, run: Run, suite_path: Path, items: list[SuiteItem], rows: dict) -> dict:
+    def _results(self, run: Run, suite_path: Path, items: list[SuiteItem], rows: dict, strokes: dict,
+                 simulated: bool) -> dict:
         summaries = {mode: summarize(r) for mode, r in rows.items()}
+        for mode, stroke_rows in strokes.items():
+            summaries[mode]["stroke_vs_onset"] = stroke_summary(stroke_rows)
+            if simulated:
+                summaries[mode]["stroke_vs_onset_simulated"] = stroke_summary(stroke_rows, simulated=True)
         missing = [{"item": r.item, "k": r.k, "trigger": r.trigger}
                    for r in next(iter(rows.values()), []) if not r.found]
         for m in missing:
@@ -97,6 +130,7 @@ class SyncEvalJob:
                        "met": words_p95 is not None and words_p95 <= self.target_p95_ms},
             "say_do": {"missing": len(missing), "records": missing},
             "gestures": {mode: [r.as_json() for r in mode_rows] for mode, mode_rows in rows.items()},
+            "strokes": {mode: [r.as_json() for r in mode_rows] for mode, mode_rows in strokes.items()},
         }
 
     @staticmethod
@@ -114,12 +148,25 @@ class SyncEvalJob:
                          ms(sched, "mean_signed_ms"), ms(actual, "mean_abs_ms"), ms(actual, "p95_abs_ms"),
                          ms(unq, "p95_abs_ms"), s["queued"], ms(s["queue_delay"], "mean_abs_ms"),
                          ms(s["scheduled_vs_center"], "p95_abs_ms")])
+        stroke_header = ["mode", "stream", "planned", "arrived", "within [-200, +100] ms", "median |offset| (ms)",
+                         "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)"]
+        stroke_rows = []
+        for mode, s in results["modes"].items():
+            for stream, key in (("command", "stroke_vs_onset"), ("simulated", "stroke_vs_onset_simulated")):
+                if key in s:
+                    st = s[key]
+                    stroke_rows.append([mode, stream, st["n"], st["arrived"], f"{st['within_window_share']:.3f}",
+                                        ms(st, "median_abs_ms"), ms(st, "p95_abs_ms"), ms(st, "median_signed_ms"),
+                                        f"{st['dropped_share']:.3f}", f"{st['preroll_p95_ms']:.0f}"])
         target = results["target"]
         say_do = results["say_do"]
         flagged = ", ".join(f"{m['item']}#{m['k']} {m['trigger']!r}" for m in say_do["records"]) or "none"
         return (f"# Speech-gesture sync ({results['items']} items from {results['suite']})\n\n"
                 f"True onsets: {results['tts']['engine']} word events (voice {results['tts']['voice']}, "
                 f"rate {results['tts']['rate']} wpm).\n\n{markdown_table(header, rows)}\n\n"
+                "## Where the executed strokes land\n\nExecuted stroke start: the first tick at which the stream "
+                "comes within 0.05 rad of the gesture's stroke-start keyframe; offset from the trigger word's onset "
+                f"(negative: before it).\n\n{markdown_table(stroke_header, stroke_rows)}\n\n"
                 f"Target: words-mode p95 |scheduled - onset| <= {target['words_p95_scheduled_vs_onset_ms']:.0f} ms: "
                 f"{'met' if target['met'] else 'NOT met'} ({target['value_ms']}).\n\n"
                 f"Say-do check: {say_do['missing']} record(s) whose trigger is not in the reply: {flagged}.\n\n"

@@ -107,12 +107,15 @@ def measure_turn(item: SuiteItem, turn, events) -> list[GestureSync]:
     spans = annotated_spans(item.text, item.anchors)
     kept = clean_events(item.text, events)
     rows = []
-    for k, (gesture, release, command) in enumerate(zip(schedule.gestures, schedule.releases, submitted.commands)):
+    commands = {c.record: c for c in submitted.commands}
+    for k, (gesture, release) in enumerate(zip(schedule.gestures, schedule.releases)):
+        command = commands.get(k)
         span, trigger = spans[k], item.anchors[k]
         onset = onset_of_span(item.text, events, *span) if span else None
         after = [t for i, t in kept.items() if span and i >= span[1]]
         center = (onset + min(after, default=turn.speech.duration_s)) / 2 if onset is not None else None
-        actual = started[command.id] - submitted.speech_start if command.id in started else None
+        actual = (started[command.id] - dispatched.speech_start
+                  if command is not None and command.id in started else None)
         queued = actual is not None and actual - release.release_s > CONTROL_DT + 1e-9
         first = span is not None and trigger_position(item.text, trigger) == span[0]
         rows.append(GestureSync(item.id, k, gesture.name, trigger, release.trigger_found, first, release.how,

@@ -40,6 +40,11 @@ class StreamTap(Backend):
     def name(self) -> str:
         return self.backend.name
 
+    @property
+    def simulated(self) -> bool:
+        """Whether `states` come from a simulator (else they repeat the commands)."""
+        return self._simulated is not None
+
     def connect(self, recorder: Recorder | None) -> np.ndarray | None:
         return self.backend.connect(recorder)
 

@@ -1,5 +1,6 @@
 """Dispatch: start the reply's audio and run the submitted commands through the 50 Hz control loop.
 
+The audio starts when the sequence stage says (after the timeline's pre-roll, if any).
 The sequence stage released the gestures against the planned speech start; when the audio actually
 starts at another time (a device's launch and output latency), the queued gestures are moved by the
 difference, so they keep their place on the words as heard.
@@ -40,7 +41,10 @@ class Dispatch:
 
     def __call__(self, turn: Turn) -> DispatchReport:
         sequencer = self.loop.sequencer
-        first_event, ticks = len(sequencer.events), self.loop.stats.ticks
+        first_event, ticks = sequencer.events.total, self.loop.stats.ticks
+        clock, play_at = self.loop.clock, turn.submitted.play_at
+        if clock.now() < play_at:  # the timeline's pre-roll: the first gesture prepares before the words
+            self.loop.wait_until(lambda: clock.now() >= play_at - 1e-9, play_at - clock.now() + 1.0)
         speech_start = self.player.play(turn.speech, self.loop.clock)
         late = speech_start - turn.submitted.speech_start
         if late:
@@ -52,5 +56,5 @@ class Dispatch:
         else:
             done = self.loop.wait_until(lambda: sequencer.settled() and sequencer.state == State.IDLE,
                                         self.timeout_s)
-        return DispatchReport(done, tuple(sequencer.events[first_event:]), self.loop.stats.ticks - ticks,
+        return DispatchReport(done, tuple(sequencer.events.since(first_event)), self.loop.stats.ticks - ticks,
                               speech_start)

@@ -1,4 +1,4 @@
-"""Schedule: release times against speech (Eq. schedule, lexical anchors).
+"""Schedule: gestures against speech (Eq. schedule, lexical anchors; or a stroke-synchronous timeline).
 
 anchor mode (the paper): the first occurrence of trigger t_k in reply r releases at
     tau_k = (pos(t_k; r) + |t_k| / 2) / max(|r|, 1) * T_a.
@@ -6,16 +6,27 @@ Missing anchors are interpolated between the neighbouring matches (0 and T_a act
 neighbours); if no trigger matches, release k is at T_a (k + 1/2) / M_g, and a lone gesture is
 released at once. words mode uses the synthesizer's true onset of the trigger's first word and falls
 back to the anchor equation where it has no word timings. Trigger search is case-insensitive.
+timeline mode (the default, beyond the paper) takes the words-mode times as the onsets the strokes must
+meet and plans every gesture's keyframe times around them (emopose/timeline.py); its release is the
+gesture's start, possibly before the speech (the pre-roll).
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
+import numpy as np
+
+from emopose.library import JointLimits
 from emopose.speech.clip import SpeechClip, Synthesizer
+from emopose.timeline import TimelinePlanner, TimelineSettings
+from emopose.trajectory import TrajectoryBuilder
 from emopose.turn import Release, ReleaseRule, Schedule, Turn
+
+MODES = ("anchor", "words", "timeline")
 
 log = logging.getLogger(__name__)
 
@@ -66,27 +77,41 @@ def word_release_times(reply: str, triggers: list[str | None], speech: SpeechCli
 @dataclass
 class ScheduleStage:
     """Stage: plan + modulated -> speech + schedule. Its synthesizer gives the reply's audio, T_a and
-    word onsets."""
+    word onsets; `limits` bound the timeline's joint speeds (the same bound the sequencer builds with) and
+    `safety` (the sequencer's check) vets its co-articulation blends."""
 
     synthesizer: Synthesizer = field(repr=False)
-    mode: Literal["anchor", "words"] = "anchor"
+    limits: JointLimits = field(repr=False)
+    safety: Callable[[np.ndarray], str | None] | None = field(default=None, repr=False)
+    mode: Literal["anchor", "words", "timeline"] = "timeline"
+    timeline: TimelineSettings = field(default_factory=TimelineSettings)
     name = "schedule"
     reads = ("plan", "modulated")
     writes = ("speech", "schedule")
 
     def __post_init__(self) -> None:
-        if self.mode not in ("anchor", "words"):
-            raise ValueError(f"pipeline.schedule.mode must be 'anchor' or 'words', got {self.mode!r}")
+        if self.mode not in MODES:
+            raise ValueError(f"pipeline.schedule.mode must be one of {MODES}, got {self.mode!r}")
+        self._planner = TimelinePlanner(TrajectoryBuilder(self.limits), self.timeline, self.safety)
 
     def __call__(self, turn: Turn) -> tuple[SpeechClip, Schedule]:
         reply = turn.plan.reply
         speech = self.synthesizer.synthesize(reply)
         triggers = [m.resolved.record.trigger for m in turn.modulated]
-        times = (word_release_times(reply, triggers, speech) if self.mode == "words"
-                 else anchor_release_times(reply, triggers, speech.duration_s))
-        releases = tuple(
-            Release(t, how, trigger_position(reply, trig) is not None) for (t, how), trig in zip(times, triggers)
-        )
-        for k in [k for k, r in enumerate(releases) if not r.trigger_found and triggers[k]]:
+        times = (anchor_release_times(reply, triggers, speech.duration_s) if self.mode == "anchor"
+                 else word_release_times(reply, triggers, speech))
+        found = [trigger_position(reply, trig) is not None for trig in triggers]
+        for k in [k for k, ok in enumerate(found) if not ok and triggers[k]]:
             log.warning("say-do check: trigger %r of record %d is not in the reply", triggers[k], k)
-        return speech, Schedule(reply, releases, tuple(turn.modulated))
+        if self.mode != "timeline":
+            releases = tuple(Release(t, how, ok) for (t, how), ok in zip(times, found))
+            return speech, Schedule(reply, releases, tuple(turn.modulated))
+        placed, preroll = self._planner.plan(list(turn.modulated), [t for t, _ in times])
+        releases = tuple(
+            Release(timing.times[0], how, ok, timing=timing) if not isinstance(timing, str)
+            else Release(t, how, ok, dropped=timing)
+            for timing, (t, how), ok in zip(placed, times, found))
+        for k, release in enumerate(releases):
+            if release.dropped:
+                log.info("timeline: gesture %d (%s) dropped: %s", k, turn.modulated[k].name, release.dropped)
+        return speech, Schedule(reply, releases, tuple(turn.modulated), preroll)

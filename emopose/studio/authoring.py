@@ -3,7 +3,9 @@
 The preview runs the execution code itself: Eq. intensity (the Modulate stage with the pipeline's
 gains and margin), Eq. smoothstep (TrajectoryBuilder.build) from the neutral rest pose, and the
 sequencer's own safety hook; so what Pose Studio shows is what the sequencer would accept or reject.
-Every intensity level is checked, because the planner may ask for any of them.
+Every intensity level is checked, and a motion that self-collides at any of them cannot be saved: the
+planner may ask for any level, and the sequencer would reject the gesture at run time (blocking the save
+is simpler and more honest than storing a per-intensity ceiling that every caller must respect).
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ from emopose.stages.modulate import Modulate
 from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 LEVELS = (1, 2, 3, 4, 5)
-NOMINAL_LEVEL = 3  # the library sequence as authored; saving requires it to pass
+NOMINAL_LEVEL = 3  # the library sequence as authored: the preview's default level
+DRAFT_NAME = "studio_draft"  # what an unsaved draft is called when it runs (the sequencer's events name it)
 
 
 class DraftError(ValueError):
@@ -52,18 +55,21 @@ class DraftReport:
     @property
     def problems(self) -> list[str]:
         """What blocks saving."""
-        out = []
-        if self.keyframe_violations:
-            out.append(f"keyframes leave the joint limits for {', '.join(self.keyframe_violations)}")
-        nominal = next(c for c in self.levels if c.intensity == NOMINAL_LEVEL)
-        if not nominal.ok:
-            out.append(f"self-collision at intensity {NOMINAL_LEVEL}: {nominal.reason}")
+        out = [self._outside_limits] if self.keyframe_violations else []
+        out += [f"self-collision at intensity {c.intensity} (the sequencer would reject it): {c.reason}"
+                for c in self.levels if not c.ok]
         return out
 
+    def refusal_at(self, intensity: int) -> str | None:
+        """Why the draft cannot be performed at this intensity (None: it can)."""
+        level = next(c for c in self.levels if c.intensity == intensity)
+        if self.keyframe_violations:
+            return self._outside_limits
+        return None if level.ok else f"self-collision at intensity {intensity}: {level.reason}"
+
     @property
-    def warnings(self) -> list[str]:
-        return [f"intensity {c.intensity} would be rejected by the sequencer: {c.reason}"
-                for c in self.levels if not c.ok and c.intensity != NOMINAL_LEVEL]
+    def _outside_limits(self) -> str:
+        return f"keyframes leave the joint limits for {', '.join(self.keyframe_violations)}"
 
 
 class PoseStudio:
@@ -78,10 +84,12 @@ class PoseStudio:
         self.builder = TrajectoryBuilder(library.limits)
 
     def draft(self, keyframes: list[list[float]], motion_type: str = "sequence",
-              duration: float | None = None) -> LibraryEntry:
-        """Schema-check the keyframes (not the limits: those are reported, so the author can fix them)."""
-        raw = {"name": "studio_draft", "class": "neutral", "description": "Pose Studio draft",
-               "motion_type": motion_type, "duration": duration, "keyframes": keyframes}
+              duration: float | None = None, cls: str = "neutral",
+              stroke: tuple[int, int] | None = None) -> LibraryEntry:
+        """Schema-check the keyframes and stroke (not the limits: those are reported, so the author can
+        fix them)."""
+        raw = {"name": DRAFT_NAME, "class": cls, "description": "Pose Studio draft",
+               "motion_type": motion_type, "duration": duration, "keyframes": keyframes, "stroke": stroke}
         try:
             return LibraryEntry.model_validate(raw)
         except ValidationError as exc:

@@ -67,7 +67,9 @@ class TourReport:
             "stops_reached": sum(s.reached for s in self.stops),
             "stops_within_tolerance": sum(s.within_tolerance for s in self.stops),
             "max_position_error_m": self.max_error_m,
-            "gestures_executed": self.gesture_events.get("completed", 0),
+            # a co-articulated gesture ends "cut" after its stroke: executed once its stroke arrived
+            "gestures_executed": self.gesture_events.get("completed", 0) + self.gesture_events.get("cut", 0),
+            "gestures_stroked": self.gesture_events.get("stroke", 0),
             "gestures_started": self.gesture_events.get("started", 0),
             "gesture_events": self.gesture_events,
             "interruptions_handled": len(self.exchanges),

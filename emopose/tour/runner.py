@@ -52,7 +52,7 @@ class TourRunner:
 
     # -- the tour ----------------------------------------------------------------------------
     def run(self) -> TourReport:
-        first_event = len(self.sequencer.events)
+        first_event = self.sequencer.events.total
         self.event("start", pose=self.base.odometry().as_dict())
         try:
             for stop in self.spec.stops_in_order:
@@ -68,7 +68,7 @@ class TourRunner:
                 self.turns.history.append({"role": "assistant", "content": closing.text})
         finally:
             self.come_to_rest()
-            self.report.finish(self.sequencer.events[first_event:], self.aborted,
+            self.report.finish(self.sequencer.events.since(first_event), self.aborted,
                                [q.text for q in self.interruptions.unasked])
             self.event("end", aborted=self.aborted, at_rest=self.report.ended_at_rest)
         return self.report
@@ -85,9 +85,9 @@ class TourRunner:
                 self.voice.speak_only(stop.approach, "approach")
             self.turns.history.append({"role": "assistant", "content": stop.approach})
         self.event("depart", stop=stop.name, goal=goal.as_dict())
-        events_before, exchanges_before = len(self.sequencer.events), len(self.report.exchanges)
+        events_before, exchanges_before = self.sequencer.events.total, len(self.report.exchanges)
         leg = self.navigator.go_to(goal, poll=lambda t: self._poll("leg", stop.name, t), handle=self.answer)
-        started = sum(e.kind == "started" for e in self.sequencer.events[events_before:])
+        started = sum(e.kind == "started" for e in self.sequencer.events.since(events_before))
         answered = sum(len(x.gestures) for x in self.report.exchanges[exchanges_before:])  # given standing
         truth = self.base.true_pose() if isinstance(self.base, GroundTruthBase) else None
         result = StopResult(
@@ -105,7 +105,7 @@ class TourRunner:
         scene = SceneView.at(self.base.odometry(), stop, self.spec.objects)
         self.scene.view = scene
         pieces, offset = sentence_chunks(stop.narration), 0.0
-        events_before = len(self.sequencer.events)
+        events_before = self.sequencer.events.total
         while pieces and not self.aborted:
             line = self.say(pieces.pop(0), "narration")
             # Scripted questions count time from the start of the whole narration, across its pieces.
@@ -123,7 +123,7 @@ class TourRunner:
             if not self.answer(question):
                 break
             self.scene.view = scene  # the answer may have updated the view
-        result.add_events(self.sequencer.events[events_before:], scene.aims)
+        result.add_events(self.sequencer.events.since(events_before), scene.aims)
 
     # -- questions ---------------------------------------------------------------------------
     def _poll(self, where: str, stop: str, elapsed_s: float) -> Question | None:
@@ -143,7 +143,7 @@ class TourRunner:
         if self.scene.view is not None:
             self.scene.view.base = self.base.odometry()
         exchange = Exchange(question.text, question.where, self.world.stream_time, self._moving_when_asked)
-        events_before = len(self.sequencer.events)
+        events_before = self.sequencer.events.total
         if wants_abort(question.text):
             line = self.say(self.spec.abort_reply, "abort", extra_history=_asked(question))
             exchange.aborted = self.aborted = True
@@ -157,7 +157,7 @@ class TourRunner:
                                 extra_history=_asked(question))
         self.voice.finish(line)
         exchange.answer = line.text
-        exchange.gestures = [e.name for e in self.sequencer.events[events_before:] if e.kind == "started"]
+        exchange.gestures = [e.name for e in self.sequencer.events.since(events_before) if e.kind == "started"]
         self.turns.history.extend([{"role": "user", "content": question.text},
                                    {"role": "assistant", "content": line.text}])
         self.report.exchanges.append(exchange)

@@ -40,7 +40,7 @@ def info(request: Request) -> dict:
 
 @router.get("/status")
 def status(request: Request) -> dict:
-    return session_of(request).status(events_from=max(0, len(session_of(request).res.sequencer.events) - 20))
+    return session_of(request).status(events_from=max(0, session_of(request).res.sequencer.events.total - 20))
 
 
 @router.get("/turns")

@@ -43,7 +43,14 @@ class DraftRequest(_Strict):
     keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
     motion_type: Literal["sequence", "pose"] = "sequence"
     duration: float | None = Field(default=None, gt=0.0, le=20.0)  # None: Eq. duration
+    stroke: tuple[int, int] | None = None  # sync points; None: the documented default (largest excursion)
     intensity: Intensity = 3
+
+
+class PerformRequest(DraftRequest):
+    model_config = ConfigDict(extra="forbid", populate_by_name=True, allow_inf_nan=False)
+
+    cls: GestureClass = Field(default="neutral", alias="class")  # the label the sequencer shows
 
 
 class PreviewRequest(DraftRequest):
@@ -59,6 +66,7 @@ class SaveRequest(_Strict):
     description: str = Field(min_length=3, max_length=200)
     motion_type: Literal["sequence", "pose"] = "sequence"
     duration: float | None = Field(default=None, gt=0.0, le=20.0)
+    stroke: tuple[int, int] | None = None
     keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
     overwrite: bool = False
 

@@ -5,6 +5,8 @@ loop never blocks and turns never overlap (the dialogue history is appended in o
 loop ticks on its own thread.
 Everything a page must hear about (turns, interruptions, saved motions) goes into one bounded log
 with increasing ids; each WebSocket sends what it has not sent yet, so every open page agrees.
+A turn is published before its gestures start; when the sequencer later rejects or drops one, the
+turn's cue in the log gets its outcome and a `cue_outcome` message tells the open pages.
 """
 
 from __future__ import annotations
@@ -20,13 +22,15 @@ from pathlib import Path
 import numpy as np
 
 from emopose.backends.capabilities import SimulatedState
-from emopose.contract import GestureRecord, Plan
+from emopose.contract import GestureRecord, LibraryEntry, Plan
 from emopose.resources import Run
 from emopose.studio.authoring import PoseStudio
-from emopose.turn import Turn
+from emopose.turn import ResolvedGesture, Turn
 from emopose.web.settings import ServeSettings
 from emopose.web.stick_figure import stick_figure
-from emopose.web.turns import summarize_turn
+from emopose.web.turns import outcome_of, summarize_turn
+
+TRACKED_COMMANDS = 2048  # command ids remembered for late outcomes (far more than the log's turns hold)
 
 
 class UnknownMotion(LookupError):
@@ -46,6 +50,11 @@ class LiveSession:
         self._turn_ids = itertools.count(1)
         self._audio: dict[int, Path] = {}
         self._stick: tuple[float, dict] | None = None
+        self._outcome_lock = threading.Lock()
+        self._events_seen = res.sequencer.events.total
+        self._cue_of: dict[int, tuple[dict, int]] = {}  # command id -> (published turn message, cue index)
+        self._refusals: dict[int, dict] = {}  # command id -> outcome, seen before or after its turn was published
+        self._strokes: dict[int, float] = {}  # command id -> clock time its stroke arrived
 
     # -- turns (called from the event loop; the work runs on the worker thread) ----------------
     async def say(self, text: str, image: bytes | None = None) -> dict:
@@ -53,6 +62,9 @@ class LiveSession:
 
     async def gesture(self, name: str, intensity: int = 3, text: str | None = None) -> dict:
         return await self._on_worker(self._gesture, name, intensity, text)
+
+    async def perform_draft(self, entry: LibraryEntry, intensity: int) -> dict:
+        return await self._on_worker(self._perform_draft, entry, intensity)
 
     @property
     def hears_speech(self) -> bool:
@@ -77,8 +89,15 @@ class LiveSession:
         if entry is None:
             raise UnknownMotion(f"no motion named {name!r} in the library (version {library.version})")
         record = GestureRecord(cls=entry.cls, variant=name, intensity=intensity, confidence=1.0)
-        turn = self.run.runner.run_plan(Plan.scripted(text or name.replace("_", " "), record))
+        turn = self.run.runner.run_plan(Plan.scripted(text or "", record))  # silent unless given words
         return self._publish_turn(turn, "gesture")
+
+    def _perform_draft(self, entry: LibraryEntry, intensity: int) -> dict:
+        """A Pose Studio draft, in no library: from modulation to dispatch like a resolved record, so the
+        joint limits and the sequencer's self-collision check judge it as they judge any gesture."""
+        record = GestureRecord(cls=entry.cls, intensity=intensity, confidence=1.0)
+        turn = self.run.runner.run_plan(Plan.scripted("", record), resolved=[ResolvedGesture(record, entry, "exact")])
+        return self._publish_turn(turn, "draft")
 
     def _publish_turn(self, turn: Turn, kind: str) -> dict:
         turn_id = next(self._turn_ids)
@@ -87,7 +106,58 @@ class LiveSession:
         if audio is not None and Path(audio).is_file():
             self._audio[turn_id] = Path(audio)
             url = f"/api/audio/{turn_id}"
-        return self.publish(summarize_turn(turn, turn_id, kind, url, self.res.library.version))
+        message = self.publish(summarize_turn(turn, turn_id, kind, url, self.res.library.version))
+        with self._outcome_lock:
+            ids = [cue["command_id"] for cue in message["cues"]]
+            for k, command_id in enumerate(ids):
+                if command_id is not None:
+                    _remember(self._cue_of, command_id, (message, k))
+            landed = [self._land(command_id) for command_id in ids if command_id in self._refusals]
+            landed += [self._land_stroke(command_id) for command_id in ids if command_id in self._strokes]
+        self._publish_outcomes(landed)
+        return message
+
+    def _track_outcomes(self) -> None:
+        """Put the sequencer's new rejections, drops and arrived strokes on their published cues (and
+        tell the pages).
+
+        A refusal may come before its turn is published (then _publish_turn lands it); an event read
+        twice (appended while the cursor moved) lands once."""
+        events = self.res.sequencer.events
+        with self._outcome_lock:
+            cursor, self._events_seen = self._events_seen, events.total
+            landed = []
+            for event in events.since(cursor):
+                if event.kind == "stroke" and event.command_id is not None:
+                    _remember(self._strokes, event.command_id, event.t)
+                    landed.append(self._land_stroke(event.command_id))
+                    continue
+                outcome = outcome_of({"kind": event.kind, "detail": event.detail})
+                if outcome is not None and event.command_id is not None:
+                    _remember(self._refusals, event.command_id, outcome)
+                    landed.append(self._land(event.command_id))
+        self._publish_outcomes(landed)
+
+    def _land(self, command_id: int) -> dict | None:
+        """Set a refused command's outcome on its published cue; the page message, or None (caller locks)."""
+        message, k = self._cue_of.get(command_id, (None, None))
+        if message is None or message["cues"][k]["outcome"] is not None:
+            return None
+        outcome = message["cues"][k]["outcome"] = self._refusals[command_id]
+        return {"type": "cue_outcome", "turn_id": message["turn_id"], "k": k, "outcome": outcome}
+
+    def _land_stroke(self, command_id: int) -> dict | None:
+        """Put an arrived stroke's time (from speech start) on its published cue; the page message."""
+        message, k = self._cue_of.get(command_id, (None, None))
+        if message is None or message["cues"][k]["stroke_executed_s"] is not None or message["speech_start"] is None:
+            return None
+        executed = message["cues"][k]["stroke_executed_s"] = self._strokes[command_id] - message["speech_start"]
+        return {"type": "cue_stroke", "turn_id": message["turn_id"], "k": k, "executed_s": executed}
+
+    def _publish_outcomes(self, landed: list[dict | None]) -> None:
+        for update in landed:
+            if update is not None:
+                self.publish(update)
 
     def interrupt(self) -> dict:
         self.res.sequencer.interrupt([], now=self.res.clock.now())
@@ -103,6 +173,7 @@ class LiveSession:
         return message
 
     def log_since(self, last_id: int) -> list[dict]:
+        self._track_outcomes()
         with self._lock:
             return [m for m in self._log if m["id"] > last_id]
 
@@ -120,9 +191,10 @@ class LiveSession:
 
     def status(self, events_from: int = 0) -> dict:
         seq, clock = self.res.sequencer, self.res.clock
+        self._track_outcomes()
         now = clock.now()
         active = seq.active
-        events = seq.events[events_from:]
+        events = seq.events.since(events_from)
         session = self.run.session
         return {
             "type": "state", "server_now": now, "state": seq.state.value,
@@ -164,3 +236,10 @@ class LiveSession:
             self.webcam.close()
         if self.renderer is not None:
             self.renderer.close()
+
+
+def _remember(table: dict, key: int, value: object) -> None:
+    """Insert into a dict kept to the TRACKED_COMMANDS newest keys (dicts keep insertion order)."""
+    table[key] = value
+    while len(table) > TRACKED_COMMANDS:
+        del table[next(iter(table))]

@@ -14,10 +14,11 @@ from fastapi import APIRouter, HTTPException, Path, Request
 from fastapi.responses import JSONResponse
 
 from emopose import CLASSES
+from emopose.contract import LibraryEntry
 from emopose.studio.authoring import DraftError, DraftReport
 from emopose.studio.saving import NAME_PATTERN, SaveRefused, save_motion
 from emopose.web.pose_renderer import RenderUnavailable
-from emopose.web.schemas import DraftRequest, PreviewRequest, SaveRequest
+from emopose.web.schemas import DraftRequest, PerformRequest, PreviewRequest, SaveRequest
 from emopose.web.session import LiveSession
 from emopose.web.stick_figure import stick_frames
 
@@ -38,7 +39,7 @@ def library_index(request: Request) -> dict:
     library = session_of(request).res.library
     snapshot, limits = library.snapshot, library.limits
     entries = [{"name": e.name, "class": e.cls, "description": e.description, "motion_type": e.motion_type,
-                "keyframes": len(e.keyframes), "duration": e.default_duration,
+                "keyframes": len(e.keyframes), "duration": e.default_duration, "stroke": list(e.stroke_span),
                 "explicit_duration": e.duration is not None} for e in snapshot.entries.values()]
     return {"version": snapshot.version, "classes": list(CLASSES), "neutral": snapshot.neutral,
             "neutral_pose": _round(library.neutral_entry.q[0]), "writable": library.write_dir is not None,
@@ -54,19 +55,23 @@ def library_entry(request: Request, name: str = Path(pattern=NAME_PATTERN)) -> d
     return entry.model_dump(mode="json", by_alias=True)
 
 
-def _report(request: Request, body: DraftRequest) -> DraftReport:
+def _draft(request: Request, body: DraftRequest, cls: str = "neutral") -> tuple[LibraryEntry, DraftReport]:
     studio = session_of(request).studio
     try:
-        entry = studio.draft(body.keyframes, body.motion_type, body.duration)
+        entry = studio.draft(body.keyframes, body.motion_type, body.duration, cls, body.stroke)
     except DraftError as exc:
         raise HTTPException(422, f"draft: {exc}") from exc
-    return studio.report(entry, body.intensity)
+    return entry, studio.report(entry, body.intensity)
+
+
+def _report(request: Request, body: DraftRequest) -> DraftReport:
+    return _draft(request, body)[1]
 
 
 @router.post("/studio/check")
 def check(body: DraftRequest, request: Request) -> dict:
     """The 50 Hz trajectory the robot would run at this intensity, and every check, before saving."""
-    report = _report(request, body)
+    entry, report = _draft(request, body)
     trajectory = report.trajectory
     k = len(body.keyframes)
     span = trajectory.duration
@@ -75,8 +80,9 @@ def check(body: DraftRequest, request: Request) -> dict:
         "explicit_duration": report.explicit_duration, "dt": trajectory.dt, "stretch": trajectory.stretch,
         "samples": _round(trajectory.samples), "keyframes": _round(report.keyframes),
         "keyframe_times": [span * i / max(k - 1, 1) for i in range(k)] if k > 1 else [span],
+        "stroke": list(entry.stroke_span), "stroke_declared": entry.stroke is not None,
         "keyframe_violations": report.keyframe_violations, "trajectory_violations": report.trajectory_violations,
-        "levels": [vars(c) for c in report.levels], "problems": report.problems, "warnings": report.warnings,
+        "levels": [vars(c) for c in report.levels], "problems": report.problems,
         "can_save": not report.problems,
         "stick": stick_frames(trajectory.samples, STICK_EVERY), "stick_dt": trajectory.dt * STICK_EVERY,
     }
@@ -100,6 +106,17 @@ def preview(body: PreviewRequest, request: Request) -> dict:
         return {"frames": [], "times": times, "fallback": "stick", "reason": str(exc)}
     frames = ["data:image/jpeg;base64," + base64.b64encode(j).decode() for j in jpegs]
     return {"frames": frames, "times": times, "camera": body.camera, "fallback": None}
+
+
+@router.post("/studio/perform")
+async def perform(body: PerformRequest, request: Request) -> dict:
+    """Run the edited draft (not the saved motion) on the robot now; the library is not changed.
+    A draft that would leave the limits or collide at this intensity is refused before it is sent."""
+    entry, report = _draft(request, body, body.cls)
+    refusal = report.refusal_at(body.intensity)
+    if refusal is not None:
+        raise HTTPException(422, f"draft not performed: {refusal}")
+    return await session_of(request).perform_draft(entry, body.intensity)
 
 
 @router.post("/library", status_code=201)

@@ -97,7 +97,7 @@ async def _send_quietly(websocket: WebSocket, message: dict) -> None:
 async def _send_loop(websocket: WebSocket, session: LiveSession) -> None:
     settings = session.settings
     last_id = max((m["id"] for m in session.log_since(0)), default=0)
-    events_from = len(session.res.sequencer.events)
+    events_from = session.res.sequencer.events.total
     frames_seen: dict[str, int] = {}
     period = 1.0 / max(settings.state_hz, settings.sim_fps)
     state_every, tick = max(1, round(max(settings.state_hz, settings.sim_fps) / settings.state_hz)), 0

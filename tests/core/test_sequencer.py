@@ -139,7 +139,7 @@ def test_unsafe_candidate_rejected_with_reason(library, rest):
     sequencer.submit(command(library, "pointing_a"))
     sequencer.step(0.0)
     assert sequencer.state == State.IDLE
-    assert sequencer.events[-1].kind == "rejected" and "torso" in sequencer.events[-1].detail
+    assert sequencer.events.recent(1)[0].kind == "rejected" and "torso" in sequencer.events.recent(1)[0].detail
 
 
 def test_submit_and_interrupt_are_thread_safe(library, rig):

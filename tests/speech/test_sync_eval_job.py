@@ -9,6 +9,7 @@ import pytest
 from emopose.app import run
 from emopose.build import build_run, make
 from emopose.config import project_path
+from emopose.sync_record import read_stroke_sync
 from tests.conftest import synthetic_library
 
 FIXTURE_SUITE = project_path("experiments/speech/sync_fixture.jsonl")
@@ -27,6 +28,26 @@ def test_sync_eval_reports_both_modes_and_meets_the_words_target(tmp_path, compo
     # execution only adds delay: at most one tick unless the gesture waited in the queue
     assert 0 <= words["tick_delay"]["max_abs_ms"] <= 20 + 1e-6
     assert results["say_do"]["records"] == [{"item": "sync-fix-08", "k": 1, "trigger": "give or take it"}]
+
+
+def test_the_timeline_lands_strokes_on_their_words_and_the_recording_measures_it_again(tmp_path, compose):
+    cfg = compose("+experiment=sync_eval", f"job.suite={FIXTURE_SUITE}", f"tts.audio_dir={tmp_path / 'tts'}",
+                  "run.record=true", "job.plots=1", *synthetic_library(tmp_path / "library"))
+    results = run(cfg, tmp_path / "run")
+    timeline, words = (results["modes"][m]["stroke_vs_onset"] for m in ("timeline", "words"))
+    assert timeline["n"] == words["n"] == 16
+    assert timeline["within_window_share"] >= 0.8 > words["within_window_share"]
+    assert timeline["median_abs_ms"] < 100 < words["median_abs_ms"]
+    assert timeline["preroll_p95_ms"] <= 400
+    assert (tmp_path / "run" / "timeline_timeline_sync-fix-01.png").stat().st_size > 10_000
+    # session.mcap alone gives the same executed strokes, gesture by gesture
+    recorded = read_stroke_sync(tmp_path / "run" / "session.mcap")
+    live = [row for mode in ("anchor", "words", "timeline") for row in results["strokes"][mode]]
+    assert len(recorded) == len(live) == 3 * 17
+    for again, row in zip(recorded, live):
+        assert (again.executed_s is None) == (row["executed_s"] is None)
+        if row["executed_s"] is not None:
+            assert again.executed_s == pytest.approx(row["executed_s"], abs=1e-6)
 
 
 def test_sync_eval_falls_back_to_the_fixture_and_needs_true_word_events(tmp_path, compose):

@@ -46,8 +46,25 @@ def test_info_and_a_typed_turn_with_timed_cues(client):
     assert [c["class"] for c in cues] == ["welcoming", "pointing"]
     first = cues[0]
     assert turn["reply"][first["char_start"]:first["char_end"]].lower() == first["trigger"].lower()
-    assert 0 <= cues[0]["release_s"] < cues[1]["release_s"] <= turn["speech"]["duration_s"]
+    # the timeline plans each stroke to land just before its trigger word (the speech may wait for it)
+    assert cues[0]["release_s"] < cues[0]["stroke_s"] < cues[1]["stroke_s"] <= turn["speech"]["duration_s"]
     assert wait_for(lambda: client.get("/api/status").json()["state"] != "idle")
+
+
+def test_each_cue_learns_where_its_stroke_actually_landed(client):
+    turn = client.post("/api/say", json={"text": "Welcome! The robot arm is over there."}).json()
+
+    def landed() -> list[dict]:
+        log = client.get("/api/turns").json()["log"]
+        return [m for m in log if m["type"] == "cue_stroke" and m["turn_id"] == turn["turn_id"]]
+
+    assert wait_for(lambda: len(landed()) == 2, timeout_s=15)
+    for update in landed():
+        planned = turn["cues"][update["k"]]["stroke_s"]
+        assert abs(update["executed_s"] - planned) <= 0.03  # one 20 ms tick (+ float noise)
+    stored = next(m for m in client.get("/api/turns").json()["log"] if m.get("turn_id") == turn["turn_id"]
+                  and m["type"] == "turn")
+    assert all(c["stroke_executed_s"] is not None for c in stored["cues"])
 
 
 def test_interrupt_clears_the_queue_and_blends(client):

@@ -7,6 +7,7 @@ restart: MotionLibrary.save reloads and the resolver and guide read the live lib
 from __future__ import annotations
 
 import pytest
+import yaml
 
 from tests.web.conftest import SHIPPED
 from tests.web.test_api import motion_body, wait_for
@@ -25,6 +26,24 @@ def test_studio_check_builds_the_50hz_trajectory_with_the_duration_rule(client):
     timed = client.post("/api/studio/check", json={"keyframes": [rest, raised, rest], "duration": 2.5}).json()
     assert timed["explicit_duration"] and len(timed["samples"]) == 126
     assert len(report["stick"]) >= 10 and set(report["stick"][0]) == {"front", "side"}
+
+
+def test_studio_shows_checks_and_saves_the_stroke(client, library_copy):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    up, further = list(rest), list(rest)
+    up[7], further[7] = -0.9, -1.1
+    frames = [rest, up, further, up, rest]
+    auto = client.post("/api/studio/check", json={"keyframes": frames}).json()
+    assert auto["stroke"] == [2, 2] and not auto["stroke_declared"]  # default: the largest excursion
+    declared = client.post("/api/studio/check", json={"keyframes": frames, "stroke": [1, 3]}).json()
+    assert declared["stroke"] == [1, 3] and declared["stroke_declared"]
+    bad = client.post("/api/studio/check", json={"keyframes": frames, "stroke": [0, 4]})
+    assert bad.status_code == 422 and "stroke [0, 4] must satisfy 1 <= start <= end <= 3" in bad.text
+    body = {"name": "reach_twice", "class": "welcoming", "description": "reaches forward twice",
+            "keyframes": frames, "stroke": [1, 3]}
+    assert client.post("/api/library", json=body).status_code == 201
+    assert client.get("/api/library/reach_twice").json()["stroke"] == [1, 3]
+    assert yaml.safe_load((library_copy / "reach_twice.yaml").read_text())["stroke"] == [1, 3]
 
 
 def test_studio_preview_without_mujoco_falls_back_to_the_stick_figure(client):
@@ -86,3 +105,52 @@ def test_a_saved_variant_resolves_and_runs_on_the_next_request(client):
     turn = client.post("/api/gesture", json={"name": "wave_test_variant"}).json()
     assert turn["cues"][0]["resolved"] == "wave_test_variant" and turn["cues"][0]["rule"] == "exact"
     assert wait_for(lambda: any(e.kind == "started" and e.name == "wave_test_variant" for e in res.sequencer.events))
+
+
+def test_studio_refuses_a_motion_that_collides_only_at_high_intensity(client, library_copy):
+    """Clean at intensities 1-3, into the torso at 4-5: the planner may ask for 5, so it is not saved."""
+    rest = client.get("/api/library").json()["neutral_pose"]
+    inward = list(rest)
+    inward[7], inward[8] = -0.5, 0.0
+    keyframes = [rest, inward, rest]
+    report = client.post("/api/studio/check", json={"keyframes": keyframes}).json()
+    assert [c["ok"] for c in report["levels"]] == [True, True, True, False, False]
+    assert not report["can_save"] and any("intensity 5" in p for p in report["problems"])
+    refused = client.post("/api/library", json={"name": "reach_in", "class": "comforting",
+                                                "description": "collides when strong", "keyframes": keyframes})
+    assert refused.status_code == 422 and "self-collision at intensity 4" in refused.json()["error"]
+    assert not (library_copy / "reach_in.yaml").exists()
+
+
+def test_an_out_of_limits_motion_names_the_offending_joint_its_value_and_its_limit(client):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    beyond = list(rest)
+    beyond[10] = 3.0  # right elbow, past its limit (not the first joint of the list)
+    body = {"name": "elbow_over", "class": "comforting", "description": "too far", "keyframes": [rest, beyond, rest]}
+    error = client.post("/api/library", json=body).json()["error"]
+    assert error.count("motion 'elbow_over'") == 1, error  # the prefix is said once
+    assert "right_elbow_joint = 3.000 rad in keyframe 1 (allowed" in error and "left_shoulder" not in error
+
+
+def test_perform_runs_the_edited_draft_not_the_saved_motion(client):
+    """The Studio's button sends the keyframes on screen; the library entry of that name is not what runs."""
+    saved = client.get("/api/library/face_wave").json()
+    draft = [list(k) for k in saved["keyframes"]]
+    draft[1][13] += 0.2  # an edit that is not saved
+    turn = client.post("/api/studio/perform", json={"keyframes": draft, "class": "welcoming", "intensity": 2}).json()
+    cue = turn["cues"][0]
+    assert turn["kind"] == "draft" and cue["resolved"] == "studio_draft" and cue["intensity"] == 2
+    assert turn["reply"] == ""  # a draft is performed silently
+    res = client.app.state.session.res
+    assert wait_for(lambda: any(e.kind == "started" and e.name == "studio_draft" for e in res.sequencer.events))
+    assert client.get("/api/library").json()["version"] == 1  # the library is untouched
+
+
+def test_perform_refuses_a_draft_that_collides_at_the_requested_intensity(client):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    inward = list(rest)
+    inward[7], inward[8] = -0.5, 0.0  # clean at 1-3, collides at 4-5
+    ok = client.post("/api/studio/perform", json={"keyframes": [rest, inward, rest], "intensity": 3})
+    assert ok.status_code == 200
+    refused = client.post("/api/studio/perform", json={"keyframes": [rest, inward, rest], "intensity": 5})
+    assert refused.status_code == 422 and "self-collision at intensity 5" in refused.json()["error"]

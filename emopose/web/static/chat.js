@@ -1,6 +1,6 @@
 // The chat page: dialogue history with timed cues, the composer, and the live robot panel.
 import { api, connect, el, fillBadges } from "./common.js";
-import { ReplyPlayer, showPlayed, turnBubble } from "./cues.js";
+import { markOutcome, markStroke, ReplyPlayer, showPlayed, turnBubble } from "./cues.js";
 import { RobotPanel } from "./robot.js";
 
 const $ = (id) => document.getElementById(id);
@@ -9,6 +9,14 @@ const robot = new RobotPanel();
 let players = [];
 let pending = null;
 let libraryVersion = null;
+let plannerName = "";
+
+// Narration planners (keyword, local, llm mode=narrate) speak the user's text as the robot's line; the page
+// says so once a turn shows it, and until then says who writes the reply.
+function showMode(narrated) {
+  $("mode-hint").textContent = narrated ? `narration: the robot says your text (planner ${plannerName})`
+    : `planner ${plannerName} writes the reply; a narration planner says your text as it is`;
+}
 
 function showError(message) {
   const banner = $("error");
@@ -25,7 +33,7 @@ function userBubble(text, gesture = false) {
 
 function addTurn(turn, live) {
   if (pending) { pending.remove(); pending = null; }
-  if (turn.kind === "gesture") history.append(userBubble(`▶ perform ${turn.cues[0]?.requested ?? ""} (i${turn.cues[0]?.intensity ?? 3})`, true));
+  if (turn.kind !== "say") history.append(userBubble(`▶ perform ${turn.cues[0]?.resolved ?? ""} (i${turn.cues[0]?.intensity ?? 3})`, true));
   else if (!history.lastElementChild?.matches(`.bubble.user[data-utterance]`)) history.append(userBubble(turn.utterance));
   history.querySelectorAll(".bubble.user[data-utterance]").forEach((n) => n.removeAttribute("data-utterance"));
   const bubble = turnBubble(turn);
@@ -46,7 +54,9 @@ function onMessage(msg) {
       $("mic").classList.toggle("hidden", !msg.asr);
       $("attach-wrap").classList.toggle("hidden", !msg.channels.camera);
       history.replaceChildren();
-      msg.log.filter((m) => m.type === "turn").forEach((t) => addTurn(t, false));
+      msg.log.filter((m) => m.type === "turn").forEach((t) => addTurn(t, false)); // outcomes are in the turns
+      plannerName = msg.planner;
+      showMode(msg.log.some((m) => m.type === "turn" && m.narrated));
       loadMotions();
       break;
     case "turn_started":
@@ -56,8 +66,18 @@ function onMessage(msg) {
       history.append(pending);
       scrollDown();
       break;
-    case "turn": addTurn(msg, true); break;
+    case "turn": addTurn(msg, true); if (msg.narrated) showMode(true); break;
     case "interrupted": players.forEach((p) => p.cancel()); break;
+    case "cue_outcome": {
+      const bubble = history.querySelector(`.bubble.robot[data-turn="${msg.turn_id}"]`);
+      if (bubble) markOutcome(bubble, msg.k, msg.outcome);
+      break;
+    }
+    case "cue_stroke": {
+      const bubble = history.querySelector(`.bubble.robot[data-turn="${msg.turn_id}"]`);
+      if (bubble) markStroke(bubble, msg.k, msg.executed_s);
+      break;
+    }
     case "library_saved": loadMotions(msg.name); break;
     case "state":
       robot.update(msg);

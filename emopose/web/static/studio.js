@@ -1,12 +1,12 @@
 // Pose Studio: author a library motion, see the trajectory the robot would run and its checks,
-// preview it in MuJoCo, save it into the live library and perform it at once.
+// preview it in MuJoCo, perform the draft on the robot, and save it into the live library.
 import { api, drawStick, el, fillBadges } from "./common.js";
 import { drawCurves } from "./studio_plot.js";
 
 const $ = (id) => document.getElementById(id);
 const MIRROR = [1, -1, -1, 1, -1, 1, -1]; // q_right = MIRROR * q_left (emopose/robot/kinematics.py)
 const NAME_RE = /^[a-z][a-z0-9_]{1,63}$/;
-const S = { library: null, keyframes: [], selected: 0, report: null, frames: null, t: 0, playing: false };
+const S = { library: null, keyframes: [], stroke: null, selected: 0, report: null, frames: null, t: 0, playing: false };
 let checkTimer = null, checkSeq = 0;
 
 const round = (v) => Math.round(v * 1000) / 1000;
@@ -27,6 +27,7 @@ function setMotion(entry) {
   $("explicit").checked = entry.duration !== null && entry.duration !== undefined;
   $("duration").value = entry.duration ?? 2.0;
   S.keyframes = entry.keyframes.map((k) => [...k]);
+  S.stroke = entry.stroke ? [...entry.stroke] : null;
   S.selected = Math.min(1, S.keyframes.length - 1);
   S.frames = null; showPreviewFrames();
   refresh();
@@ -36,15 +37,23 @@ function setMotion(entry) {
 function newMotion() {
   const up = neutral(); up[7] = -0.9; up[8] = -0.5; up[10] = 0.2; // right arm raised forward-out: clean at every intensity
   setMotion({ name: "", class: "welcoming", description: "", motion_type: "sequence", duration: null,
-              keyframes: [neutral(), up, neutral()] });
+              keyframes: [neutral(), up, neutral()], stroke: [1, 1] });
 }
 
 function draft() {
   return { keyframes: S.keyframes, motion_type: $("motion-type").value, intensity: Number($("intensity").value),
-           duration: $("explicit").checked ? Number($("duration").value) : null };
+           duration: $("explicit").checked ? Number($("duration").value) : null, stroke: S.stroke };
+}
+
+// Sync points: the stroke is a span of interior keyframes; an edit that breaks it falls back to auto.
+function fixStroke() {
+  const K = S.keyframes.length, pose = $("motion-type").value === "pose";
+  if (pose) S.stroke = null;
+  else if (S.stroke && !(1 <= S.stroke[0] && S.stroke[0] <= S.stroke[1] && S.stroke[1] <= K - 2)) S.stroke = null;
 }
 
 function refresh() {
+  fixStroke();
   renderKeyframes(); renderSliders(); renderNameHint();
   $("duration").disabled = !$("explicit").checked;
   clearTimeout(checkTimer);
@@ -55,7 +64,8 @@ function renderKeyframes() {
   const list = $("keyframes");
   list.replaceChildren(...S.keyframes.map((kf, k) => el("li", { class: k === S.selected ? "selected" : "", onclick: () => { S.selected = k; refresh(); } },
     el("span", { class: "k", text: `K${k}` }),
-    el("span", { class: "sum", text: kf.map((v) => v.toFixed(2)).join(" ") }))));
+    el("span", { class: "sum", text: kf.map((v) => v.toFixed(2)).join(" ") }),
+    el("span", { class: "stroke-mark", text: strokeMark(k) }))));
   const pose = $("motion-type").value === "pose";
   $("kf-add").disabled = pose || S.keyframes.length >= 14;
   $("kf-remove").disabled = S.keyframes.length <= (pose ? 1 : 3);
@@ -82,16 +92,35 @@ function refreshLight() { // a slider moved: keep the DOM of the sliders, redo t
   renderKeyframes(); clearTimeout(checkTimer); checkTimer = setTimeout(check, 120);
 }
 
+const nameExists = () => S.library.entries.some((e) => e.name === $("name").value);
+
 function updateSaveButton() {
-  $("save").disabled = !(S.report && S.report.can_save && NAME_RE.test($("name").value) && $("description").value.trim().length >= 3);
+  $("save").disabled = !(S.report && S.report.can_save && NAME_RE.test($("name").value) && $("description").value.trim().length >= 3
+    && (!nameExists() || $("overwrite").checked));
 }
 
 function renderNameHint() {
   updateSaveButton();
-  const name = $("name").value, exists = S.library.entries.some((e) => e.name === name);
+  const name = $("name").value, exists = nameExists();
   $("overwrite-wrap").classList.toggle("hidden", !exists);
   $("name-hint").textContent = !name ? "name it to save: lower case letters, digits and _"
-    : !NAME_RE.test(name) ? "⚠ names must match ^[a-z][a-z0-9_]{1,63}$" : exists ? "this name exists: saving replaces it" : "new motion";
+    : !NAME_RE.test(name) ? "⚠ names must match ^[a-z][a-z0-9_]{1,63}$"
+    : exists ? "this name exists: tick “replace the existing motion” to save over it" : "new motion";
+}
+
+function strokeSpan() { return S.stroke || (S.report ? S.report.stroke : null); }
+
+function strokeMark(k) {
+  const span = strokeSpan();
+  if (!span || $("motion-type").value === "pose") return "";
+  return k === span[0] && k === span[1] ? "stroke" : k === span[0] ? "stroke ▸" : k === span[1] ? "◂ stroke" : "";
+}
+
+function renderStroke() {
+  const pose = $("motion-type").value === "pose", span = strokeSpan();
+  for (const id of ["stroke-start", "stroke-end", "stroke-auto"]) $(id).disabled = pose;
+  $("stroke-label").textContent = pose ? "a pose is its own stroke"
+    : span ? `K${span[0]}–K${span[1]}${S.stroke ? "" : " (auto: largest excursion)"}` : "";
 }
 
 async function check() {
@@ -100,7 +129,7 @@ async function check() {
     const report = await api("/api/studio/check", draft());
     if (seq !== checkSeq) return; // a newer edit is on its way
     S.report = report; S.t = 0;
-    renderChecks(report); drawAll();
+    renderChecks(report); renderKeyframes(); renderStroke(); drawAll();
     if (S.frames && S.frames.key !== JSON.stringify(draft())) $("preview-caption").textContent = "edited since the render: Render in MuJoCo again";
     if (!S.playing) play();
   } catch (error) {
@@ -116,12 +145,11 @@ function renderChecks(r) {
   $("traj-meta").textContent = `${r.samples.length} samples · ${((r.samples.length - 1) * r.dt).toFixed(2)} s · intensity ${r.intensity}`;
   $("check-limits").replaceChildren(r.keyframe_violations.length
     ? el("span", { class: "pill bad", text: `outside: ${r.keyframe_violations.join(", ")}` }) : el("span", { class: "pill ok", text: "within limits" }));
-  $("check-levels").replaceChildren(...r.levels.map((c) => el("span", { class: `pill ${c.ok ? "ok" : c.intensity === 3 ? "bad" : "warn"}`,
+  $("check-levels").replaceChildren(...r.levels.map((c) => el("span", { class: `pill ${c.ok ? "ok" : "bad"}`,
     title: c.reason || "", text: `i${c.intensity} ${c.ok ? "✓" : "✗"} ${(c.min_clearance_m * 100).toFixed(1)} cm` })));
   $("check-speed").replaceChildren(r.stretch > 1.001
     ? el("span", { class: "pill warn", text: `slowed ×${r.stretch.toFixed(2)} to respect joint speed limits` }) : el("span", { class: "pill ok", text: "within speed limits" }));
-  $("check-notes").replaceChildren(...r.problems.map((p) => el("li", { class: "bad", style: "color:var(--bad)", text: p })),
-    ...r.warnings.map((w) => el("li", { style: "color:var(--warn)", text: w })));
+  $("check-notes").replaceChildren(...r.problems.map((p) => el("li", { class: "bad", style: "color:var(--bad)", text: p })));
   $("verdict").replaceChildren(el("span", { class: `pill ${r.can_save ? "ok" : "bad"}`, text: r.can_save ? "ready to save" : "cannot save" }));
   updateSaveButton();
 }
@@ -176,20 +204,21 @@ async function save() {
   const out = $("save-result");
   try {
     const saved = await api("/api/library", { name: $("name").value, class: $("class").value, description: $("description").value,
-      motion_type: $("motion-type").value, duration: draft().duration, keyframes: S.keyframes, overwrite: $("overwrite").checked });
+      motion_type: $("motion-type").value, duration: draft().duration, stroke: S.stroke, keyframes: S.keyframes, overwrite: $("overwrite").checked });
     out.className = "ok";
     out.textContent = `saved ${saved.name} → ${saved.file}` + (saved.backup ? ` (backup ${saved.backup})` : "") + ` · library v${saved.version}: the planner and resolver see it now`;
     await loadLibrary(saved.name); renderNameHint();
   } catch (error) { out.className = "bad"; out.textContent = error.message; }
 }
 
+// Runs the keyframes on screen (saved or not) through the same checks as any gesture; the library is unchanged.
 async function perform() {
   const out = $("perform-result");
   try {
-    const turn = await api("/api/gesture", { name: $("name").value, intensity: Number($("intensity").value) });
-    const cue = turn.cues[0];
-    out.textContent = `resolved ${cue.requested} → ${cue.resolved} (${cue.rule}) at library v${turn.library_version}; running on the robot`;
-    out.className = cue.resolved === cue.requested ? "ok" : "bad";
+    const turn = await api("/api/studio/perform", { ...draft(), class: $("class").value });
+    out.className = "ok";
+    out.textContent = `performing the draft on screen at intensity ${turn.cues[0].intensity}`
+      + ` (as ${turn.cues[0].resolved}; the library is unchanged)`;
   } catch (error) { out.className = "bad"; out.textContent = error.message; }
 }
 
@@ -207,7 +236,12 @@ $("motion-type").onchange = () => edit(() => {
   else if (S.keyframes.length < 3) { S.keyframes = [neutral(), kf(), neutral()]; S.selected = 1; }
 });
 for (const id of ["explicit", "duration", "intensity"]) $(id).onchange = refresh;
+const interior = () => Math.min(Math.max(S.selected, 1), S.keyframes.length - 2);
+$("stroke-start").onclick = () => edit(() => { const k = interior(); S.stroke = [k, Math.max(k, strokeSpan()?.[1] ?? k)]; });
+$("stroke-end").onclick = () => edit(() => { const k = interior(); S.stroke = [Math.min(k, strokeSpan()?.[0] ?? k), k]; });
+$("stroke-auto").onclick = () => edit(() => { S.stroke = null; });
 $("name").oninput = renderNameHint;
+$("overwrite").onchange = updateSaveButton;
 $("description").oninput = updateSaveButton;
 $("open").onclick = async () => setMotion(await api(`/api/library/${encodeURIComponent($("open-name").value)}`));
 $("new").onclick = newMotion;

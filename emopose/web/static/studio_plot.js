@@ -1,5 +1,6 @@
 // Pose Studio's curve plot: the 50 Hz trajectory of each joint (left arm | right arm, 7 rows),
-// keyframe times as dashed lines (the selected one solid), hard limits in red when in view.
+// keyframe times as dashed lines (the selected one solid), the stroke span shaded, hard limits in red
+// when in view.
 
 const SHORT = ["shoulder pitch", "shoulder roll", "shoulder yaw", "elbow", "wrist roll", "wrist pitch", "wrist yaw"];
 
@@ -29,6 +30,10 @@ export function drawCurves(canvas, report, limits, selected, cursor = null) {
     g.strokeStyle = "#d64545"; g.setLineDash([2, 2]); g.lineWidth = 1;
     for (const limit of [limits.lower[j], limits.upper[j]]) {
       if (limit > lo && limit < hi) { g.beginPath(); g.moveTo(x0, Y(limit)); g.lineTo(x0 + w, Y(limit)); g.stroke(); }
+    }
+    if (report.stroke && report.keyframes.length > 1) { // the stroke span: what the timeline puts on the word
+      const [a, b] = report.stroke.map((k) => X(report.keyframe_times[k]));
+      g.fillStyle = "rgba(47, 111, 237, 0.12)"; g.fillRect(a - 2, y0, Math.max(b - a, 0) + 4, h);
     }
     report.keyframe_times.forEach((t, k) => {
       g.strokeStyle = k === selected ? "#2f6fed" : "#c5cddb";

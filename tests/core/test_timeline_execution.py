@@ -1,0 +1,151 @@
+"""The sequencer executing timelines: keyframes on their times, strokes reported, co-articulation cuts,
+and a continuous, speed-bounded stream through random timelines and interrupts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from emopose.backends.dry_run import DryRunBackend
+from emopose.clock import FakeClock
+from emopose.control_loop import ControlLoop
+from emopose.sequencer import GestureCommand, Sequencer, State
+from emopose.stages.sequence import SequenceStage
+from emopose.timeline import TimelinePlanner, TimelineSettings
+from emopose.trajectory import TrajectoryBuilder
+from emopose.turn import Release
+from tests.core.conftest import gesture
+
+NAMES = ("point_forward_right", "palm_stop", "chop_right", "face_wave", "shrug", "open_arms", "beat_both_hands",
+         "point_up", "wave_off", "calm_down_palms")
+
+
+class Rig:
+    def __init__(self, library):
+        self.library = library
+        self.clock = FakeClock()
+        self.rest = library.neutral_entry.q[0]
+        self.sequencer = Sequencer(TrajectoryBuilder(library.limits), self.rest)
+        self.loop = ControlLoop(self.sequencer, DryRunBackend(), self.clock)
+        self.loop.begin(self.rest)
+        self.stream: list[tuple[float, np.ndarray]] = []
+
+    def run(self, seconds: float) -> None:
+        for _ in range(round(seconds / self.loop.dt)):
+            q = self.loop.tick()
+            self.stream.append((self.clock.now(), q))
+
+    def plan(self, gestures, onsets, speech_start: float) -> list[tuple[GestureCommand, Release]]:
+        """The sequence stage's commands for a planned timeline, speech starting at speech_start."""
+        planner = TimelinePlanner(TrajectoryBuilder(self.library.limits), TimelineSettings())
+        timings, _ = planner.plan(gestures, onsets)
+        releases = tuple(Release(t.times[0], "words", True, timing=t) if not isinstance(t, str)
+                         else Release(0.0, "words", True, dropped=t) for t in timings)
+        commands = [SequenceStage._command(k, g, r, speech_start) for k, (g, r) in enumerate(zip(gestures, releases))]
+        return sorted(zip(commands, releases), key=lambda p: p[0].release_at)
+
+    def submit(self, gestures, onsets, speech_start: float) -> list[GestureCommand]:
+        planned = self.plan(gestures, onsets, speech_start)
+        for command, release in planned:
+            if release.dropped:
+                self.sequencer.drop(command, release.dropped, self.clock.now())
+            else:
+                self.sequencer.submit(command)
+        return sorted((c for c, r in planned if not r.dropped), key=lambda c: c.record)
+
+    def steps(self) -> np.ndarray:
+        q = np.array([s[1] for s in self.stream])
+        return np.abs(np.diff(q, axis=0))
+
+    def events(self, kind: str):
+        return [e for e in self.sequencer.events if e.kind == kind]
+
+
+def test_a_timed_command_reaches_its_stroke_keyframe_at_the_planned_time(g1):
+    rig = Rig(g1)
+    point = gesture(g1, "point_forward_right")
+    (command,) = rig.submit([point], [1.5], speech_start=0.5)
+    rig.run(5.0)
+    stroke = next(e for e in rig.events("stroke") if e.command_id == command.id)
+    assert stroke.t == pytest.approx(0.5 + 1.5 - 0.05, abs=0.021)  # arrival: speech start + onset + lead
+    keyframe = command.keyframes[command.stroke[0]]
+    arrived = [t for t, q in rig.stream if np.max(np.abs(q - keyframe)) <= 0.05]
+    assert arrived[0] == pytest.approx(stroke.t, abs=1e-9)
+    # and the stream passes through the keyframe itself at its planned time
+    at = command.release_at + command.offsets[command.stroke[0]]
+    tick = min(range(len(rig.stream)), key=lambda i: abs(rig.stream[i][0] - at))
+    assert np.max(np.abs(rig.stream[tick][1] - keyframe)) < 0.03
+    assert rig.events("started")[0].t == pytest.approx(command.release_at, abs=0.021)
+
+
+def test_coarticulated_gestures_go_from_stroke_to_stroke_without_rest(g1):
+    rig = Rig(g1)
+    first, second = rig.submit([gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")], [1.0, 2.6], 0.0)
+    assert first.cut and second.blend_in
+    rig.run(6.0)
+    assert [e.name for e in rig.events("cut")] == ["point_forward_right"]
+    assert [e.name for e in rig.events("completed")] == ["palm_stop"]
+    cut_at = rig.events("cut")[0].t
+    between = [q for t, q in rig.stream if cut_at - 0.2 <= t <= cut_at + 0.2]
+    assert min(np.max(np.abs(q - rig.rest)) for q in between) > 0.5  # never near rest in between
+    assert np.all(rig.steps() <= g1.limits.max_velocity * rig.loop.dt + 1e-9)
+
+
+def test_a_late_timed_command_preempts_the_running_motion_without_a_jump(g1):
+    rig = Rig(g1)
+    slow = gesture(g1, "calm_down_palms")
+    rig.sequencer.submit(GestureCommand("calm_down_palms", slow.keyframes, slow.duration))
+    rig.run(1.0)
+    rig.submit([gesture(g1, "point_left")], [0.6], speech_start=rig.clock.now())
+    rig.run(4.0)
+    assert rig.events("cut")[0].name == "calm_down_palms"
+    assert np.all(rig.steps() <= g1.limits.max_velocity * rig.loop.dt + 1e-9)
+
+
+def test_dropped_gestures_are_reported_and_never_run(g1):
+    rig = Rig(g1)
+    rig.submit([gesture(g1, "chop_right"), gesture(g1, "beat_both_hands")], [1.0, 1.2], 0.0)
+    rig.run(6.0)
+    (dropped,) = rig.events("dropped")
+    assert dropped.name == "beat_both_hands" and dropped.detail.startswith("no room")
+    assert [e.name for e in rig.events("started")] == ["chop_right"]
+
+
+def test_the_event_log_stays_bounded_and_cursors_still_work(g1):
+    sequencer = Sequencer(TrajectoryBuilder(g1.limits), g1.neutral_entry.q[0], keep_events=5)
+    cursor = sequencer.events.total
+    for k in range(12):
+        sequencer.drop(GestureCommand(f"g{k}", np.zeros((1, 14)), 1.0), "test", float(k))
+    assert len(sequencer.events) == 5 and sequencer.events.total == cursor + 12
+    assert [e.name for e in sequencer.events.since(cursor + 9)] == ["g9", "g10", "g11"]
+    assert [e.name for e in sequencer.events.since(cursor)] == [f"g{k}" for k in range(7, 12)]
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(picks=st.lists(st.tuples(st.sampled_from(NAMES), st.integers(1, 5), st.floats(0.0, 6.0)), min_size=1,
+                      max_size=4),
+       interrupt_at=st.one_of(st.none(), st.floats(0.1, 6.0)),
+       replacement=st.sampled_from(["nothing", "a queued motion", "a new timeline"]))
+def test_random_timelines_and_interrupts_keep_the_stream_continuous(g1, picks, interrupt_at, replacement):
+    rig = Rig(g1)
+    gestures = [gesture(g1, name, intensity) for name, intensity, _ in picks]
+    rig.submit(gestures, [onset for *_, onset in picks], speech_start=0.4)
+    if interrupt_at is None:
+        rig.run(12.0)
+    else:
+        rig.run(interrupt_at)
+        follow = gesture(g1, "shrug")
+        new = {"nothing": [], "a queued motion": [GestureCommand("shrug", follow.keyframes, follow.duration)],
+               "a new timeline": [c for c, r in rig.plan([follow], [0.3], rig.clock.now()) if not r.dropped]}
+        rig.sequencer.interrupt(new[replacement], now=rig.clock.now())
+        assert len(rig.sequencer.pending) == (1 if replacement == "a new timeline" else 0)
+        rig.run(10.0)
+        if replacement != "nothing":
+            assert rig.events("started")[-1].name == "shrug"
+    assert np.all(rig.steps() <= g1.limits.max_velocity * rig.loop.dt + 1e-9)
+    assert rig.sequencer.state in (State.IDLE, State.HOLDING)
+    lower, upper = g1.limits.lower, g1.limits.upper
+    q = np.array([s[1] for s in rig.stream])
+    assert np.all(q >= lower - 1e-9) and np.all(q <= upper + 1e-9)
