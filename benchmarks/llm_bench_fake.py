@@ -2,11 +2,15 @@
 
 480 requests (one EmoPose-Bench run) go through LLMPlanner.plan_many -> litellm -> real HTTP on
 127.0.0.1 to tests/planners/fake_openai.py, which answers every request after --delay seconds;
---bad-rate of the answers are bad, half malformed JSON and half HTTP 500 (each retry draws again).
-Reports wall time (target <= 15 s for 480 requests at 200 ms), crashes (plan_many raising or an
-output missing: target 0), retries, fallbacks, how the parser saw the answers, and latency.
+--bad-rate of the answers are bad, drawn evenly from --mix (default: half malformed JSON, half HTTP
+500; each retry draws again). Reports wall time (target <= 15 s for 480 requests at 200 ms), crashes
+(plan_many raising or an output missing: target 0), retries, how the parser saw the answers, latency
+(server time and queueing apart), and the accounting (issue 17): every unusable answer the server
+sent must be counted as a fallback, and top-1 accuracy (the right class is the good answer's,
+welcoming) must equal 1 minus the share of fallbacks that chose another class.
 The response cache is off so every request reaches the server.
-Run: python benchmarks/llm_bench_fake.py [--requests 480] [--concurrency 16]  -> JSON on stdout.
+Run: python benchmarks/llm_bench_fake.py [--requests 480] [--concurrency 16] [--bad-rate 0.3 --mix malformed
+truncated plain unknown_class fenced loud http_500]  -> JSON on stdout.
 """
 
 from __future__ import annotations
@@ -27,20 +31,22 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 from conftest import load_library, make_library_dir
+from planners.fake_answers import FAULTS, PLAN, UNUSABLE
 
 from emopose.planners.base import PlanRequest, plan_all
 from emopose.planners.llm import LLMPlanner
-from emopose.stages.parse import parse_plan
+from emopose.stages.parse import parse_output
 
 FAKE_SERVER = ROOT / "tests" / "planners" / "fake_openai.py"
+RIGHT_CLASS = PLAN["gestures"][0]["class"]
 
 
 @contextmanager
-def fake_server(delay_s: float, bad_rate: float, seed: int):
+def fake_server(delay_s: float, bad_rate: float, seed: int, mix: list[str]):
     """The fake provider in its own process, as a real provider would be: (url, stats())."""
     proc = subprocess.Popen([sys.executable, str(FAKE_SERVER), "--delay", str(delay_s), "--bad-rate",
-                             str(bad_rate), "--seed", str(seed)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                            text=True)
+                             str(bad_rate), "--seed", str(seed), "--mix", *mix], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True)
     try:
         url = json.loads(proc.stdout.readline())["url"]
         stats_url = url.removesuffix("/v1") + "/stats"
@@ -69,10 +75,12 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--model", default="openai/gpt-4o-mini", help="any litellm model string; served by the fake")
     parser.add_argument("--target-s", type=float, default=15.0)
+    parser.add_argument("--mix", nargs="+", default=["malformed", "http_500"], choices=sorted(FAULTS))
     args = parser.parse_args()
 
     logging.getLogger("emopose.stages.parse").setLevel(logging.ERROR)  # 10% malformed: expected warnings
-    with tempfile.TemporaryDirectory() as tmp, fake_server(args.delay, args.bad_rate, args.seed) as (url, stats):
+    with tempfile.TemporaryDirectory() as tmp, fake_server(args.delay, args.bad_rate, args.seed,
+                                                           args.mix) as (url, stats):
         library = load_library(make_library_dir(Path(tmp) / "library"))
         planner = LLMPlanner(library=library, template=str(ROOT / "prompts/structured.md"),
                              demonstrations=str(ROOT / "prompts/demonstrations.jsonl"),
@@ -93,7 +101,11 @@ def main() -> None:
         after, counters = stats(), planner.stats()
     served = Counter(after["served"])
     served.subtract(before["served"])
-    sources = Counter(parse_plan(o.raw, r.utterance).source for o, r in zip(outputs, requests))
+    plans = [parse_output(o, r.utterance) for o, r in zip(outputs, requests)]
+    unusable = sum(served[kind] for kind in UNUSABLE)
+    fallbacks = sum(p.fallback for p in plans)
+    harmful = sum(p.fallback and p.top_class != RIGHT_CLASS for p in plans)
+    accuracy = sum(p.top_class == RIGHT_CLASS for p in plans) / max(1, len(plans))
     report = {
         "requests": args.requests, "model": args.model, "concurrency": args.concurrency,
         "answer_delay_s": args.delay, "bad_rate": args.bad_rate,
@@ -101,10 +113,16 @@ def main() -> None:
         "requests_per_s": round(args.requests / wall_s, 1),
         "crashes": int(crash is not None), "crash": crash, "missing_outputs": args.requests - len(outputs),
         "server_requests": after["requests"] - before["requests"], "served": dict(+served),
-        "retries": counters["retries"], "fallbacks": sum(o.fallback for o in outputs),
-        "parsed_as": dict(sources),
+        "retries": counters["retries"], "failed_calls": counters["failed_calls"],
+        "sources": dict(Counter(p.source for p in plans)),
+        "unusable_answers_sent": unusable, "fallbacks_counted": fallbacks,
+        "every_unusable_answer_counted": fallbacks == unusable + counters["failed_calls"],
+        "accuracy": round(accuracy, 4), "harmful_share": round(harmful / max(1, len(plans)), 4),
+        "accuracy_is_1_minus_harmful_share": abs(accuracy - (1 - harmful / max(1, len(plans)))) < 1e-9,
         "latency_mean_s": round(counters["latency_mean_s"], 3),
         "latency_p95_s": round(counters["latency_p95_s"], 3),
+        "queue_mean_s": round(counters["queue_mean_s"], 3),
+        "queue_p95_s": round(counters["queue_p95_s"], 3),
     }
     print(json.dumps(report, indent=2))
 

@@ -36,7 +36,11 @@ def beside(ours: dict | None, paper: tuple | None) -> str:
 
 
 def row_label(result: dict) -> str:
-    return result.get("label") or result.get("method", "?")
+    """The row's name; a run that fell back more than its limit is marked, whatever the table."""
+    label = result.get("label") or result.get("method", "?")
+    if result.get("fallback_exceeded"):
+        label += f" (FALLBACKS {100 * result['fallback_share']:.0f} %: not the planner's score)"
+    return label
 
 
 def _paper_only(table: dict, ran: set[str], keys: Sequence[str]) -> list[list]:

@@ -15,10 +15,16 @@ from emopose.bench.confusion import ABBREVIATIONS, ConfusionPanel, confusion_cou
 from emopose.bench.metrics import accuracy, by_pass, tier_accuracy
 from emopose.bench.suites import TIERS, load_bench
 from emopose.bench.tables import comparison_markdown, fmt
-from emopose.resources import Resources, Run
 from emopose.jobs.report import write_results
-from emopose.jobs.suite_planning import plan_suite, resolve_passes, run_summary
+from emopose.jobs.suite_planning import (
+    MAX_FALLBACK_SHARE,
+    check_fallback_share,
+    plan_suite,
+    resolve_passes,
+    run_summary,
+)
 from emopose.planners.base import PlanRequest
+from emopose.resources import Resources, Run
 
 
 @dataclass
@@ -28,6 +34,7 @@ class BenchJob:
     passes: int | None = None  # None: 5 for a sampled planner, 1 otherwise
     chunk_size: int = 64
     progress: bool = True
+    max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
     confusion: bool = True
 
     def __call__(self, run: Run) -> dict:
@@ -47,7 +54,8 @@ class BenchJob:
                                  self.chunk_size, self.progress)
             planned_all.extend(planned)
             for item, outcome in zip(items, planned):
-                row = {"id": item.id, "label": item.label, "pred": outcome.top_class, "tier": item.tier, "pass": p}
+                row = {"id": item.id, "label": item.label, "pred": outcome.top_class, "tier": item.tier, "pass": p,
+                       "source": outcome.source}
                 if outcome.error is not None:
                     row["error"] = outcome.error
                 predictions.append(row)
@@ -61,7 +69,7 @@ class BenchJob:
             "accuracy": tier_accuracy(predictions, TIERS),
             "per_pass": [{t: accuracy((q["label"], q["pred"]) for q in preds if q["tier"] == t)
                           for t in self.tiers} for preds in by_pass(predictions).values()],
-            **run_summary(planned_all, started),
+            **run_summary(planned_all, started, self.max_fallback_share),
             "predictions": predictions,
         }
         markdown = comparison_markdown([results]) + "\n" + leading_confusions(predictions, self.tiers)
@@ -70,6 +78,7 @@ class BenchJob:
             markdown += f"\nConfusion matrices: {results['confusion_png']}\n"
         write_results(res.run_dir, results, markdown)
         print(markdown)
+        check_fallback_share(results)
         return results
 
     def write_confusion(self, res: Resources, predictions: list[dict], results: dict):

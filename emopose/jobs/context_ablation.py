@@ -13,10 +13,16 @@ from dataclasses import dataclass
 from emopose.bench.metrics import paired_context_accuracy
 from emopose.bench.suites import load_context
 from emopose.bench.tables import comparison_markdown
-from emopose.resources import Run
 from emopose.jobs.report import write_results
-from emopose.jobs.suite_planning import plan_suite, resolve_passes, run_summary
+from emopose.jobs.suite_planning import (
+    MAX_FALLBACK_SHARE,
+    check_fallback_share,
+    plan_suite,
+    resolve_passes,
+    run_summary,
+)
 from emopose.planners.base import PlanRequest
+from emopose.resources import Run
 
 
 @dataclass
@@ -25,6 +31,7 @@ class ContextAblationJob:
     passes: int | None = None  # None: 5 for a sampled planner, 1 otherwise
     chunk_size: int = 64
     progress: bool = True
+    max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
 
     def __call__(self, run: Run) -> dict:
         res = run.resources
@@ -44,7 +51,8 @@ class ContextAblationJob:
             planned_all += planned_with + planned_without
             for item, a, b in zip(items, planned_with, planned_without):
                 predictions.append({"id": item.id, "label": item.label, "pred_with": a.top_class,
-                                    "pred_without": b.top_class, "history_turns": len(item.history), "pass": p})
+                                    "pred_without": b.top_class, "history_turns": len(item.history), "pass": p,
+                                    "source_with": a.source, "source_without": b.source})
         paired = paired_context_accuracy(predictions)
         results = {
             "kind": "context_ablation",
@@ -55,7 +63,7 @@ class ContextAblationJob:
             "accuracy": {k: paired[k] for k in ("with_history", "without_history", "gain")},
             "per_pass": paired["per_pass"],
             "discordant": paired["discordant"],
-            **run_summary(planned_all, started),
+            **run_summary(planned_all, started, self.max_fallback_share),
             "predictions": predictions,
         }
         d = paired["discordant"]
@@ -64,4 +72,5 @@ class ContextAblationJob:
             f"right only without {d['only_without_history']}.\n")
         write_results(res.run_dir, results, markdown)
         print(markdown)
+        check_fallback_share(results)
         return results

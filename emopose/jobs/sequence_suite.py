@@ -15,10 +15,17 @@ from emopose.bench.metrics import aggregate_passes
 from emopose.bench.sequence_metrics import SequencePrediction, suite_scores
 from emopose.bench.suites import load_sequence
 from emopose.bench.tables import comparison_markdown
-from emopose.resources import Run
 from emopose.jobs.report import write_results
-from emopose.jobs.suite_planning import PlannedItem, plan_suite, resolve_passes, run_summary
+from emopose.jobs.suite_planning import (
+    MAX_FALLBACK_SHARE,
+    PlannedItem,
+    check_fallback_share,
+    plan_suite,
+    resolve_passes,
+    run_summary,
+)
 from emopose.planners.base import PlanRequest
+from emopose.resources import Run
 
 COUNT_KEYS = ("over", "under", "failed")
 
@@ -38,6 +45,7 @@ class SequenceSuiteJob:
     check_variants: bool = True
     chunk_size: int = 64
     progress: bool = True
+    max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
 
     def __call__(self, run: Run) -> dict:
         res = run.resources
@@ -56,10 +64,10 @@ class SequenceSuiteJob:
             planned_all.extend(planned)
             preds = [as_prediction(o) for o in planned]
             per_pass.append(suite_scores(items, preds))
-            for item, pred in zip(items, preds):
+            for item, pred, outcome in zip(items, preds, planned):
                 predictions.append({"id": item.id, "labels": list(item.labels), "pred": None if pred.classes is None
                                     else list(pred.classes), "triggers": list(pred.triggers),
-                                    "variants": list(pred.variants), "pass": p})
+                                    "variants": list(pred.variants), "pass": p, "source": outcome.source})
         rates = [{k: v for k, v in scores.items() if k not in COUNT_KEYS} for scores in per_pass]
         results = {
             "kind": "sequence_suite",
@@ -71,7 +79,7 @@ class SequenceSuiteJob:
             "segmentation": {f"{k}_total": sum(s[k] for s in per_pass) for k in COUNT_KEYS}
             | {f"{k}_per_pass": [s[k] for s in per_pass] for k in COUNT_KEYS},
             "per_pass": per_pass,
-            **run_summary(planned_all, started),
+            **run_summary(planned_all, started, self.max_fallback_share),
             "predictions": predictions,
         }
         seg = results["segmentation"]
@@ -80,4 +88,5 @@ class SequenceSuiteJob:
             f"{seg['under_total']} under-segmented, {seg['failed_total']} failed.\n")
         write_results(res.run_dir, results, markdown)
         print(markdown)
+        check_fallback_share(results)
         return results

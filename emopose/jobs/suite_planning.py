@@ -3,7 +3,10 @@
 Requests go through emopose.planners.base.plan_all in chunks (so planners with a concurrent or batched
 `plan_many` keep their speed, and a progress line can advance). If a chunk raises, its items are
 retried one by one, and an item whose planner call raises is recorded as a failure (plan None) while
-the run continues. Every answer is parsed with the one contract parser, parse_plan.
+the run continues; a PlannerFailure (the planner cannot answer at all) stops the run instead. Every
+answer is parsed with the one contract parser (parse_output), whose Plan.source is each prediction's
+source; `fallbacks` counts every answer that is not a usable model record, and a run whose fallback
+share exceeds `max_fallback_share` is written, marked, and then fails (check_fallback_share).
 """
 
 from __future__ import annotations
@@ -11,28 +14,39 @@ from __future__ import annotations
 import logging
 import sys
 import time
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from emopose.contract import Plan
-from emopose.planners.base import Planner, PlannerOutput, PlanRequest, plan_all
-from emopose.stages.parse import parse_plan
+from emopose.planners.base import Planner, PlannerFailure, PlannerOutput, PlanRequest, plan_all
+from emopose.stages.parse import parse_output
 
 log = logging.getLogger(__name__)
 
 SAMPLED_PASSES = 5
+MAX_FALLBACK_SHARE = 0.2  # the default limit of a suite job's job.max_fallback_share
 
 
 @dataclass(frozen=True)
 class PlannedItem:
-    """One request's outcome: the parsed plan (None if the planner raised), latency, fallback flag."""
+    """One request's outcome: the parsed plan (None if the planner raised), latency, error."""
 
     plan: Plan | None
     latency_s: float | None = None
-    fallback: bool = False
     error: str | None = None
+    queue_s: float | None = None  # waiting for a concurrency slot, apart from latency_s (LLM planners)
+
+    @property
+    def source(self) -> str:
+        """Where the prediction came from (PlanSource), or "failed" when the planner raised."""
+        return "failed" if self.plan is None else self.plan.source
+
+    @property
+    def fallback(self) -> bool:
+        return self.plan is not None and self.plan.fallback
 
     @property
     def top_class(self) -> str | None:
@@ -53,9 +67,8 @@ def resolve_passes(passes: int | None, planner: Planner) -> int:
 
 
 def _outcome(output: PlannerOutput, request: PlanRequest) -> PlannedItem:
-    plan = parse_plan(output.raw, request.utterance)
-    fallback = bool(output.fallback) or plan.source == "keyword_fallback"
-    return PlannedItem(plan, output.latency_s, fallback, output.error)
+    return PlannedItem(parse_output(output, request.utterance), output.latency_s, output.error,
+                       output.meta.get("queue_s"))
 
 
 def _plan_chunk(planner: Planner, chunk: Sequence[PlanRequest]) -> list[PlannedItem]:
@@ -64,12 +77,16 @@ def _plan_chunk(planner: Planner, chunk: Sequence[PlanRequest]) -> list[PlannedI
         if len(outputs) != len(chunk):
             raise RuntimeError(f"planner returned {len(outputs)} outputs for {len(chunk)} requests")
         return [_outcome(o, r) for o, r in zip(outputs, chunk)]
+    except PlannerFailure:
+        raise
     except Exception:  # any planner error: isolate the failing item(s) one by one below
         log.warning("planner failed on a chunk of %d; retrying item by item", len(chunk), exc_info=True)
     items = []
     for request in chunk:
         try:
             items.append(_outcome(planner.plan(request), request))
+        except PlannerFailure:
+            raise
         except Exception as exc:  # noqa: BLE001 - a failed item is a result, not a crash
             log.warning("planner failed on %r: %s", request.utterance[:60], exc)
             items.append(PlannedItem(plan=None, error=f"{type(exc).__name__}: {exc}"[:300]))
@@ -91,15 +108,33 @@ def plan_suite(planner: Planner, requests: Sequence[PlanRequest], label: str = "
     return results
 
 
-def latency_summary(items: Sequence[PlannedItem]) -> dict:
-    """Planner latency in seconds: mean and 95th percentile over items that have one."""
-    values = np.array([i.latency_s for i in items if i.latency_s is not None], dtype=float)
+def latency_summary(items: Sequence[PlannedItem], attribute: str = "latency_s") -> dict:
+    """Planner latency (or queueing) in seconds: mean and 95th percentile over items that have one."""
+    values = np.array([getattr(i, attribute) for i in items if getattr(i, attribute) is not None], dtype=float)
     if values.size == 0:
         return {"mean": None, "p95": None}
     return {"mean": float(values.mean()), "p95": float(np.percentile(values, 95))}
 
 
-def run_summary(planned: Sequence[PlannedItem], started: float) -> dict:
-    """The fields every suite job reports about its planning run (fallbacks, failures, latency, wall time)."""
-    return {"fallbacks": sum(i.fallback for i in planned), "failures": sum(i.plan is None for i in planned),
-            "latency_s": latency_summary(planned), "wall_s": time.perf_counter() - started}
+def run_summary(planned: Sequence[PlannedItem], started: float, max_fallback_share: float = MAX_FALLBACK_SHARE) -> dict:
+    """The fields every suite job reports about its planning run: fallbacks (and their share of all
+    answers, against the limit), failures, the count of each source, latency and wall time."""
+    if not 0.0 <= max_fallback_share <= 1.0:
+        raise ValueError(f"job.max_fallback_share = {max_fallback_share} must be in [0, 1]")
+    fallbacks = sum(i.fallback for i in planned)
+    share = fallbacks / len(planned) if planned else 0.0
+    return {"fallbacks": fallbacks, "fallback_share": share, "max_fallback_share": max_fallback_share,
+            "fallback_exceeded": share > max_fallback_share, "failures": sum(i.plan is None for i in planned),
+            "sources": dict(Counter(i.source for i in planned)), "latency_s": latency_summary(planned),
+            "queue_s": latency_summary(planned, "queue_s"),
+            "wall_s": time.perf_counter() - started}
+
+
+def check_fallback_share(results: dict) -> None:
+    """After the results are written: a run that fell back too often fails (exit 2) rather than pass
+    the keyword rules off as the planner's score."""
+    if results.get("fallback_exceeded"):
+        raise PlannerFailure(
+            f"planner {results['method']} fell back on {results['fallbacks']} answers "
+            f"({100 * results['fallback_share']:.1f} % > job.max_fallback_share {100 * results['max_fallback_share']:.0f} %;"
+            f" sources {results['sources']}); the results are written and marked, but are not the planner's score")

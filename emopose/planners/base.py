@@ -29,13 +29,26 @@ class PlanRequest:
 
 @dataclass(frozen=True)
 class PlannerOutput:
-    """The planner's raw answer in contract JSON, its latency, and whether it is a fallback answer."""
+    """The planner's raw answer in contract JSON, its latency, and whether it is a fallback answer.
+
+    fallback: the model gave no answer (the call failed for good) and `raw` holds the keyword rules'.
+    meta["attempts"]: requests it took (> 1: transient errors were retried); 0 for a cached answer.
+    line: the words the robot must say whatever the answer (narrate mode); parse keeps them when the
+    answer is not a usable plan, so chatter from the model is never spoken in place of the line.
+    """
 
     raw: str
     latency_s: float = 0.0
     fallback: bool = False
     error: str | None = None
     meta: dict = field(default_factory=dict)
+    line: str | None = None
+
+
+class PlannerFailure(RuntimeError):
+    """The planner's answers cannot stand as its result: it cannot answer at all (endpoint gone, key
+    revoked), or a suite run fell back on too many items. The CLI exits 2 with this one-line cause
+    instead of reporting keyword fallbacks as the planner's score."""
 
 
 @runtime_checkable

@@ -3,7 +3,9 @@
 Same model, client, sampling, cache, dialogue history and demonstrations as planner=llm, but the
 prompt (prompts/direct_label.md) keeps only the class definitions and asks for one class label:
 no priority rules, no library guide, no record schema. The label becomes one contract record
-(variant left to the resolver's class default), so the rest of the pipeline is unchanged.
+(variant left to the resolver's class default), so the rest of the pipeline is unchanged. An
+answer without a label is passed on as it came, so the parser reports it (plain_text, a fallback)
+instead of a silent neutral.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ class DirectLabelPlanner(ChatPlanner):
 
     def to_contract(self, text: str, request: PlanRequest) -> str:
         label = label_from_answer(text)
-        record = {"class": label or "neutral", "variant": None, "intensity": 3, "trigger": None,
-                  "confidence": 1.0 if label else 0.0}
+        if label is None:
+            return text
+        record = {"class": label, "variant": None, "intensity": 3, "trigger": None, "confidence": 1.0}
         return json.dumps({"reply": request.utterance, "gestures": [record]})

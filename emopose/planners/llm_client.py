@@ -1,9 +1,9 @@
 """One chat-completion client for every LLM planner: litellm, our own retry loop, a response cache.
 
 The retry loop is ours (litellm's and the OpenAI SDK's own retries are switched off) so the number
-of attempts is visible to counters and tests, and so only transient failures are retried: 429,
-408/409, 5xx, timeouts and dropped connections. A 4xx such as a bad key or a bad request fails at
-once. litellm is imported on first use: it takes seconds to import and most runs never call it.
+of attempts is visible to counters and tests, and so only transient failures are retried
+(emopose/planners/llm_errors.py sorts them). litellm is imported on first use: it takes seconds to
+import and most runs never call it.
 """
 
 from __future__ import annotations
@@ -11,17 +11,15 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import itertools
-import logging
-import random
 import threading
 import time
-from dataclasses import dataclass, field
-
-import numpy as np
+from dataclasses import dataclass
 
 from emopose.planners.llm_cache import ResponseCache, cache_key
+from emopose.planners.llm_counters import CallCounters
+from emopose.planners.llm_errors import LLMCallError, LLMConfigError, backoff_delay, cause, is_transient
+from emopose.planners.llm_errors import litellm_module as _litellm
 
-TRANSIENT_STATUS = frozenset({408, 409, 429})
 NO_KEY_PLACEHOLDER = "no-key-needed"  # the OpenAI SDK refuses a missing key even for a local server
 
 
@@ -33,42 +31,6 @@ def effective_api_key(litellm, model: str, api_base: str | None, api_key: str | 
     return None if litellm.validate_environment(model=model).get("keys_in_environment") else NO_KEY_PLACEHOLDER
 
 
-class LLMConfigError(ValueError):
-    """The planner's model configuration cannot work; raised by check() before a benchmark starts."""
-
-
-class LLMCallError(RuntimeError):
-    """A call failed for good (after the retries, or at once for a non-transient error)."""
-
-    def __init__(self, message: str, latency_s: float = 0.0) -> None:
-        super().__init__(message)
-        self.latency_s = latency_s
-
-
-def _litellm():
-    import litellm  # late: seconds to import, and most runs never call a hosted model
-    litellm.suppress_debug_info = True  # otherwise every exception prints a help banner to stdout
-    logging.getLogger("LiteLLM").setLevel(logging.WARNING)  # two INFO lines per call drown a run's log
-    return litellm
-
-
-def is_transient(exc: BaseException) -> bool:
-    litellm = _litellm()
-    if isinstance(exc, (litellm.Timeout, litellm.APIConnectionError)):
-        return True
-    status = getattr(exc, "status_code", None)
-    return isinstance(status, int) and (status in TRANSIENT_STATUS or status >= 500)
-
-
-def backoff_delay(attempt: int, base_s: float, cap_s: float, exc: BaseException | None = None) -> float:
-    """Exponential backoff with jitter (so parallel calls do not retry in lockstep); honours Retry-After."""
-    delay = min(cap_s, base_s * 2**attempt) * (0.5 + random.random() / 2)
-    headers = getattr(exc, "litellm_response_headers", None) or {}
-    with contextlib.suppress(TypeError, ValueError):
-        delay = max(delay, min(cap_s, float(headers.get("retry-after", 0))))
-    return delay
-
-
 @dataclass(frozen=True)
 class Completion:
     text: str
@@ -76,35 +38,7 @@ class Completion:
     cached: bool
     finish_reason: str | None = None
     latency_s: float = 0.0  # model time incl. retries and backoff; 0 for a cache hit
-
-
-@dataclass
-class CallCounters:
-    """Counters shared by a client and its planner; thread-safe because the web UI plans from threads."""
-
-    calls: int = 0
-    cache_hits: int = 0
-    retries: int = 0
-    fallbacks: int = 0
-    latencies_s: list[float] = field(default_factory=list)  # model calls only; a cache hit is not inference
-    _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
-
-    def add(self, **counts: int) -> None:
-        with self._lock:
-            for name, n in counts.items():
-                setattr(self, name, getattr(self, name) + n)
-
-    def latency(self, seconds: float) -> None:
-        with self._lock:
-            self.latencies_s.append(seconds)
-
-    def stats(self) -> dict:
-        with self._lock:
-            lat = np.asarray(self.latencies_s, dtype=float)
-            return {"calls": self.calls, "cache_hits": self.cache_hits, "retries": self.retries,
-                    "fallbacks": self.fallbacks, "model_calls": int(lat.size),
-                    "latency_mean_s": float(lat.mean()) if lat.size else None,
-                    "latency_p95_s": float(np.percentile(lat, 95)) if lat.size else None}
+    queued_s: float = 0.0  # time spent waiting for a concurrency slot (plan_many), apart from latency_s
 
 
 class LLMClient:
@@ -135,52 +69,38 @@ class LLMClient:
         """True when repeated passes are independent draws (temperature > 0; the pass index keys the cache)."""
         return self.temperature > 0
 
-    def check(self) -> None:
-        """Fail fast on a model string litellm cannot route or a hosted provider without its API key."""
-        litellm = _litellm()
-        try:
-            litellm.get_llm_provider(model=self.model, api_base=self.api_base)
-        except Exception as exc:
-            raise LLMConfigError(
-                f"planner.model = {self.model!r} is not a litellm model string ({str(exc).splitlines()[0][:160]}); "
-                "use provider/name, e.g. openai/gpt-4o-mini, anthropic/claude-3-5-haiku-latest, "
-                "or hosted_vllm/NAME with planner.api_base") from exc
-        if self.api_base or self.api_key:
-            return  # a local or proxy server: it decides whether it wants a key
-        env = litellm.validate_environment(model=self.model)
-        if not env.get("keys_in_environment"):
-            raise LLMConfigError(
-                f"planner.model = {self.model!r} needs {env.get('missing_keys')} in the environment: export it, "
-                "set planner.api_key, or point planner.api_base at a local OpenAI-compatible server")
-
     # -- one request -------------------------------------------------------------------------
-    def _key(self, messages: list[dict], pass_index: int) -> str:
+    def _key(self, messages: list[dict], pass_index: int, response_format: dict | None) -> str:
         return cache_key({"model": self.model, "api_base": self.api_base, "messages": messages,
                           "temperature": self.temperature, "max_tokens": self.max_tokens,
-                          "extra": self.extra_params, "pass": pass_index if self.sampled else None})
+                          "extra": self.extra_params, "pass": pass_index if self.sampled else None,
+                          **({"response_format": response_format} if response_format else {})})
 
-    def _call_kwargs(self, messages: list[dict]) -> dict:
+    def call_kwargs(self, messages: list[dict], response_format: dict | None = None, **overrides) -> dict:
+        """litellm.completion's arguments for one request (`overrides`: e.g. the probe's max_tokens=1)."""
         api_key = self._effective_key()
         kwargs = {"model": self.model, "messages": messages, "temperature": self.temperature,
                   "timeout": self.timeout_s, "max_retries": 0, "num_retries": 0, **self.extra_params}
         if self.max_tokens:
             kwargs["max_tokens"] = self.max_tokens
+        if response_format:
+            kwargs["response_format"] = response_format
         if self.api_base:
             kwargs["api_base"] = self.api_base
         if api_key:
             kwargs["api_key"] = api_key
-        return kwargs
+        return {**kwargs, **overrides}
 
     def _effective_key(self) -> str | None:
         if self._key_resolved is None:  # asked once: validate_environment reads the environment
             self._key_resolved = (effective_api_key(_litellm(), self.model, self.api_base, self.api_key),)
         return self._key_resolved[0]
 
-    def _draw_key(self, messages: list[dict], pass_index: int) -> str:
+    def _draw_key(self, messages: list[dict], pass_index: int, response_format: dict | None) -> str:
         """The cache key of this call. While sampling, the n-th identical request (n > 0) within this
         client's life is its own draw: five passes whose job never set pass_index still get five
         samples, and a rerun in a new process replays them in the same order."""
-        key = self._key(messages, pass_index)
+        key = self._key(messages, pass_index, response_format)
         if not self.sampled:
             return key
         with self._repeats_lock:
@@ -188,42 +108,45 @@ class LLMClient:
             self._repeats[key] = repeat + 1
         return cache_key({"draw": key, "repeat": repeat}) if repeat else key
 
-    def _lookup(self, messages: list[dict], pass_index: int) -> tuple[str | None, Completion | None]:
+    def _lookup(self, messages: list[dict], pass_index: int,
+                response_format: dict | None) -> tuple[str | None, Completion | None]:
         self.counters.add(calls=1)
         if self.cache is None:
             return None, None
-        key = self._draw_key(messages, pass_index)
+        key = self._draw_key(messages, pass_index, response_format)
         text = self.cache.get(key)
         if text is None:
             return key, None
         self.counters.add(cache_hits=1)
         return key, Completion(text, attempts=0, cached=True)
 
-    def _retry_delay(self, exc: Exception, attempt: int, started: float) -> float:
+    def _retry_delay(self, exc: Exception, attempt: int, started: float, queued_s: float = 0.0) -> float:
         """Backoff before the next attempt, or raise LLMCallError when the failure is final."""
         if attempt >= self.max_retries or not is_transient(exc):
             latency = time.perf_counter() - started
-            self.counters.latency(latency)
+            self.counters.latency(latency, queued_s)
             raise LLMCallError(f"{type(exc).__name__} after {attempt + 1} attempt(s): {str(exc)[:300]}",
-                               latency) from exc
+                               latency, cause(exc, self.model, self.api_base)) from exc
         self.counters.add(retries=1)
         return backoff_delay(attempt, self.backoff_s, self.backoff_max_s, exc)
 
-    def _finish(self, key: str | None, response, attempts: int, started: float) -> Completion:
+    def _finish(self, key: str | None, response, attempts: int, started: float, queued_s: float = 0.0) -> Completion:
         latency = time.perf_counter() - started
-        self.counters.latency(latency)
+        self.counters.latency(latency, queued_s)
         choice = response.choices[0]
         text = choice.message.content or ""
         if self.cache and key and text.strip():  # an empty answer is usually a provider hiccup: ask again next time
             self.cache.put(key, text, {"model": self.model, "finish_reason": choice.finish_reason})
-        return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason, latency_s=latency)
+        return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason, latency_s=latency,
+                          queued_s=queued_s)
 
-    def complete(self, messages: list[dict], pass_index: int = 0) -> Completion:  # type: ignore[return]
+    def complete(self, messages: list[dict], pass_index: int = 0,
+                 response_format: dict | None = None) -> Completion:  # type: ignore[return]
         """The answer to one chat request: from the cache, or from the model with retries."""
-        key, hit = self._lookup(messages, pass_index)
+        key, hit = self._lookup(messages, pass_index, response_format)
         if hit is not None:
             return hit
-        kwargs, started = self._call_kwargs(messages), time.perf_counter()
+        kwargs, started = self.call_kwargs(messages, response_format), time.perf_counter()
         for attempt in itertools.count():
             try:
                 response = _litellm().completion(**kwargs)
@@ -232,22 +155,25 @@ class LLMClient:
                 continue
             return self._finish(key, response, attempt + 1, started)
 
-    async def acomplete(self, messages: list[dict], pass_index: int = 0,
-                        gate: asyncio.Semaphore | None = None) -> Completion:  # type: ignore[return]
-        """As complete(); `gate` bounds requests on the wire (a call in backoff frees its slot). Queueing
-        for a slot is the batch's scheduling, not model latency: the latency origin skips it."""
-        key, hit = self._lookup(messages, pass_index)
+    async def acomplete(self, messages: list[dict], pass_index: int = 0, gate: asyncio.Semaphore | None = None,
+                        response_format: dict | None = None) -> Completion:  # type: ignore[return]
+        """As complete(); `gate` bounds requests on the wire (a call in backoff frees its slot). Waiting
+        for a slot is the batch's queueing, not model latency: it is counted apart (queue_s)."""
+        key, hit = self._lookup(messages, pass_index, response_format)
         if hit is not None:
             return hit
-        kwargs, slot, started = self._call_kwargs(messages), gate or contextlib.nullcontext(), None
+        kwargs, slot = self.call_kwargs(messages, response_format), gate or contextlib.nullcontext()
+        started, queued_s = None, 0.0
         for attempt in itertools.count():
             queued = time.perf_counter()
             async with slot:
-                started = time.perf_counter() if started is None else started + time.perf_counter() - queued
+                waited = time.perf_counter() - queued
+                queued_s += waited
+                started = time.perf_counter() if started is None else started + waited
                 try:
                     response = await _litellm().acompletion(**kwargs)
                 except Exception as exc:  # noqa: BLE001 - as in complete()
-                    delay = self._retry_delay(exc, attempt, started)
+                    delay = self._retry_delay(exc, attempt, started, queued_s)
                 else:
-                    return self._finish(key, response, attempt + 1, started)
+                    return self._finish(key, response, attempt + 1, started, queued_s)
             await asyncio.sleep(delay)

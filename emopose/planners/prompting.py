@@ -120,6 +120,11 @@ def label_demonstrations(demos: list[Demonstration]) -> str:
                        for k, d in enumerate(demos, start=1))
 
 
+def dialogue_demonstrations(demos: list[Demonstration]) -> str:
+    """Examples for a chat model that only talks (planner=annotate): the person's words and the reply."""
+    return "\n\n".join(f"Person: {d.text}\nRobot: {d.reply}" for d in demos)
+
+
 def image_data_uri(image: str | bytes) -> str:
     """An image file path or raw bytes as a base64 data URI (OpenAI image_url content part)."""
     if isinstance(image, (bytes, bytearray)):

@@ -3,7 +3,8 @@
 Accepts bare or fenced JSON ({"reply", "gestures": [...]}, a bare list of records, or one record),
 clamps intensity to the integers 1..5 and confidence to [0, 1], maps an unknown class to neutral,
 turns plain text into one neutral record, and on a JSON decode or value failure falls back to the
-keyword classifier, logging that it did.
+keyword classifier, logging that it did. Plan.source says honestly which of these happened
+(emopose/contract.py, PlanSource): only "model" and "retried" are the model's own usable records.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from typing import Any
 
 from emopose import CLASSES
 from emopose.contract import GestureRecord, Plan
+from emopose.planners.base import PlannerOutput
 from emopose.planners.keyword import keyword_records
 from emopose.turn import Turn
 
@@ -64,24 +66,22 @@ def _text(value: Any) -> str | None:
     return text[:200] or None
 
 
-def _record(raw: Any) -> tuple[GestureRecord, list[str]]:
+def _record(raw: Any) -> tuple[GestureRecord, str | None]:
+    """The record, and the class the model named when it is not one of the eight (mapped to neutral)."""
     if not isinstance(raw, dict):
         raise PlanValueError(f"a gesture record must be an object, got {type(raw).__name__}")
-    notes = []
     label = str(raw.get("class", raw.get("cls", raw.get("label", "neutral")))).strip().lower()
-    if label not in CLASSES:
-        notes.append(f"unknown class {label[:40]!r} mapped to neutral")
-        label = "neutral"
+    unknown = None if label in CLASSES else label[:40]
     intensity = _number(raw.get("intensity", 3), "intensity")
     confidence = _number(raw.get("confidence", 1.0), "confidence")
     record = GestureRecord(
-        cls=label,
+        cls="neutral" if unknown is not None else label,
         variant=_text(raw.get("variant")),
         intensity=int(min(5, max(1, round(min(max(intensity, -1e9), 1e9))))),
         trigger=_text(raw.get("trigger")),
         confidence=min(1.0, max(0.0, confidence)),
     )
-    return record, notes
+    return record, unknown
 
 
 def _plan_from_json(data: Any, fallback_reply: str) -> Plan:
@@ -95,35 +95,52 @@ def _plan_from_json(data: Any, fallback_reply: str) -> Plan:
     if not isinstance(gestures, list):
         raise PlanValueError("gestures must be a list")
     reply = _text(data.get("reply")) if data.get("reply") is not None else None
-    records, notes = [], []
+    records, notes, source = [], [], "model"
     for raw in gestures[:MAX_RECORDS]:
-        record, record_notes = _record(raw)
+        record, unknown = _record(raw)
         records.append(record)
-        notes.extend(record_notes)
+        if unknown is not None:
+            notes.append(f"unknown class {unknown!r} mapped to neutral")
+            source = "unknown_class"
     if len(gestures) > MAX_RECORDS:
         notes.append(f"kept the first {MAX_RECORDS} of {len(gestures)} records")
     if not records:
         records.append(GestureRecord(cls="neutral"))
         notes.append("no gesture records; used one neutral record")
-    return Plan(reply=reply or fallback_reply, records=tuple(records), source="model", notes=tuple(notes))
+        source = "no_records"
+    return Plan(reply=reply or fallback_reply, records=tuple(records), source=source, notes=tuple(notes))
 
 
-def parse_plan(raw: str | None, utterance: str = "") -> Plan:
-    """The parser. `utterance` is the reply used when the model gives none (narration mode)."""
+def parse_plan(raw: str | None, utterance: str = "", line: str | None = None) -> Plan:
+    """The parser. `utterance` is the reply used when the model gives none (narration mode); `line`, when
+    given, is what the robot must say whatever the answer, so plain text never replaces it."""
     text = (raw or "")[:MAX_RAW_CHARS]
     if not text.strip():
-        return Plan(reply=utterance, records=(GestureRecord(cls="neutral"),), source="empty",
+        return Plan(reply=line or utterance, records=(GestureRecord(cls="neutral"),), source="empty",
                     notes=("empty model output; one neutral record",))
     candidate = _json_candidate(text)
     if candidate is None:
-        return Plan(reply=text.strip()[:2000], records=(GestureRecord(cls="neutral"),), source="plain_text")
+        return Plan(reply=line or text.strip()[:2000], records=(GestureRecord(cls="neutral"),), source="plain_text",
+                    notes=("plain-text answer; one neutral record",))
     try:
         return _plan_from_json(json.loads(candidate), utterance)
     except (json.JSONDecodeError, PlanValueError, RecursionError, ValueError) as exc:
         log.warning("model output unusable (%s); keyword fallback", str(exc)[:200])
-        source_text = utterance or text
-        return Plan(reply=utterance or text.strip()[:2000], records=tuple(keyword_records(source_text)),
+        source_text = line or utterance or text
+        return Plan(reply=line or utterance or text.strip()[:2000], records=tuple(keyword_records(source_text)),
                     source="keyword_fallback", notes=(f"keyword fallback: {str(exc)[:200]}",))
+
+
+def parse_output(output: PlannerOutput, utterance: str = "") -> Plan:
+    """A planner's output as a Plan whose source is the truth: a failed call's keyword answer is
+    call_failed (never "model"), and a usable answer that needed retries is "retried"."""
+    plan = parse_plan(output.raw, utterance, output.line)
+    if output.fallback:
+        return plan.model_copy(update={"source": "call_failed",
+                                       "notes": (*plan.notes, f"planner call failed: {output.error}")})
+    if plan.source == "model" and output.meta.get("attempts", 1) > 1:
+        return plan.model_copy(update={"source": "retried"})
+    return plan
 
 
 class Parse:
@@ -134,4 +151,4 @@ class Parse:
     writes = ("plan",)
 
     def __call__(self, turn: Turn) -> Plan:
-        return parse_plan(turn.planner_output.raw, turn.request.utterance)
+        return parse_output(turn.planner_output, turn.request.utterance)

@@ -16,87 +16,22 @@ sitting out its delay is not, so a client that returned before it has timed out)
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
-import random
+import socket
 import sys
 import threading
 import time
 from collections import Counter, deque
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Self
 
-PLAN_JSON = json.dumps({
-    "reply": "Welcome! The screen is over there.",
-    "gestures": [
-        {"class": "welcoming", "variant": "welcoming_a", "intensity": 3, "trigger": "Welcome",
-         "confidence": 0.9},
-        {"class": "pointing", "variant": "pointing_b", "intensity": 4, "trigger": "over there",
-         "confidence": 0.8},
-    ],
-})
+from fake_answers import FAULTS, PLAN_JSON, Answer, faulty, http_error, ok
+
+__all__ = ["PLAN_JSON", "Answer", "FakeOpenAI"]
+
 CHAT_PATHS = ("/v1/chat/completions", "/chat/completions")
-
-
-@dataclass
-class Answer:
-    """One scripted reply: a chat message `content`, or an HTTP error `status` with an error body."""
-
-    content: str | None = ""
-    status: int = 200
-    delay_s: float = 0.0
-    finish_reason: str = "stop"
-    headers: dict[str, str] = field(default_factory=dict)
-    kind: str = "custom"  # how GET /stats counts it
-
-
-def ok(content: str = PLAN_JSON, delay_s: float = 0.0) -> Answer:
-    return Answer(content=content, delay_s=delay_s, kind="ok")
-
-
-def malformed() -> Answer:
-    return Answer(content='{"reply": "Sure", "gestures": [{"class": "agreeing", intensity: high}', kind="malformed")
-
-
-def empty() -> Answer:
-    return Answer(content="", kind="empty")
-
-
-def truncated() -> Answer:
-    return Answer(content=PLAN_JSON[: len(PLAN_JSON) // 2], finish_reason="length", kind="truncated")
-
-
-def oversized(chars: int = 300_000) -> Answer:
-    return Answer(content=PLAN_JSON + " " * chars, kind="oversized")
-
-
-def http_error(status: int = 500) -> Answer:
-    return Answer(content=None, status=status, kind=f"http_{status}")
-
-
-def rate_limited(retry_after_s: float = 0.0) -> Answer:
-    return Answer(content=None, status=429, headers={"retry-after": str(retry_after_s)},
-                  kind="rate_limited")
-
-
-def slow(delay_s: float, content: str = PLAN_JSON) -> Answer:
-    return Answer(content=content, delay_s=delay_s, kind="slow")
-
-
-def faulty(delay_s: float, bad_rate: float, seed: int = 0) -> Callable[[dict, int], Answer]:
-    """A default for load tests: every answer after delay_s; bad_rate of them bad, half malformed JSON
-    and half HTTP 500, drawn per request (so a retried 500 draws again) from a seeded generator."""
-    rng, lock = random.Random(seed), threading.Lock()
-
-    def answer(body: dict, index: int) -> Answer:
-        with lock:
-            draw = rng.random()
-        chosen = http_error(500) if draw < bad_rate / 2 else malformed() if draw < bad_rate else ok()
-        chosen.delay_s = delay_s
-        return chosen
-
-    return answer
 
 
 def _completion_body(answer: Answer, model: str) -> dict:
@@ -108,16 +43,38 @@ def _completion_body(answer: Answer, model: str) -> dict:
     }
 
 
-def _error_body(status: int) -> dict:
+def _error_body(status: int, message: str | None = None) -> dict:
     kind = {429: "rate_limit_exceeded", 401: "invalid_api_key"}.get(status, "server_error")
-    return {"error": {"message": f"scripted HTTP {status}", "type": kind, "code": kind}}
+    return {"error": {"message": message or f"scripted HTTP {status}", "type": kind, "code": kind}}
+
+
+def prompt_tokens(body: dict) -> int:
+    """A server-side token estimate (4 characters a token), as a context-window check would make."""
+    return len(json.dumps(body.get("messages", []))) // 4
+
+
+def context_overflow(window: int) -> Callable[[dict], Answer | None]:
+    """A gate: a request whose prompt + max_tokens exceeds `window` gets OpenAI's context-length 400."""
+
+    def gate(body: dict) -> Answer | None:
+        wanted = prompt_tokens(body) + int(body.get("max_tokens") or 0)
+        if wanted <= window:
+            return None
+        return http_error(400, f"This model's maximum context length is {window} tokens. However, you "
+                               f"requested {wanted} tokens. Please reduce the length of the messages.")
+
+    return gate
 
 
 class FakeOpenAI:
     """The server; use as a context manager, or start()/stop()."""
 
-    def __init__(self, default: Answer | Callable[[dict, int], Answer] | None = None) -> None:
+    def __init__(self, default: Answer | Callable[[dict, int], Answer] | None = None, api_key: str | None = None,
+                 models: tuple[str, ...] | None = None, context_window: int | None = None) -> None:
+        """`api_key`: 401 without it; `models`: 404 for any other model; `context_window`: 400 above it."""
         self.default = default or ok()
+        self.api_key, self.models = api_key, models
+        self.gate = context_overflow(context_window) if context_window else None
         self.requests: list[dict] = []
         self.paths: list[str] = []
         self.served: Counter[str] = Counter()  # answer kinds sent, e.g. {"ok": 9, "http_500": 1}
@@ -125,6 +82,7 @@ class FakeOpenAI:
         self._script: deque[Answer] = deque()
         self._lock = threading.Lock()
         self._stopping = threading.Event()
+        self._connections: set[socket.socket] = set()  # open keep-alive connections, closed by stop()
         self._server = ThreadingHTTPServer(("127.0.0.1", 0), self._handler_class())
         self._server.daemon_threads = True
         self._thread = threading.Thread(target=self._server.serve_forever, kwargs={"poll_interval": 0.02},
@@ -150,9 +108,14 @@ class FakeOpenAI:
         return self
 
     def stop(self) -> None:
+        """Die as a killed process does: stop listening and drop every open connection."""
         self._stopping.set()  # wakes handlers sleeping in a slow answer
         self._server.shutdown()
         self._server.server_close()
+        with self._lock:
+            for connection in self._connections:
+                with contextlib.suppress(OSError):
+                    connection.shutdown(socket.SHUT_RDWR)
 
     def __enter__(self) -> Self:
         return self.start()
@@ -160,15 +123,24 @@ class FakeOpenAI:
     def __exit__(self, *exc: object) -> None:
         self.stop()
 
-    def _next_answer(self, body: dict, path: str) -> Answer:
+    def _refusal(self, body: dict, authorization: str | None) -> Answer | None:
+        """What a real server says before it runs the model: bad key, unknown model, too long a prompt."""
+        if self.api_key and authorization != f"Bearer {self.api_key}":
+            return http_error(401, "Incorrect API key provided.")
+        if self.models is not None and body.get("model") not in self.models:
+            return http_error(404, f"The model `{body.get('model')}` does not exist or you do not have access to it.")
+        return self.gate(body) if self.gate else None
+
+    def _next_answer(self, body: dict, path: str, authorization: str | None = None) -> Answer:
+        refusal = self._refusal(body, authorization)
         with self._lock:
             index = len(self.requests)
             self.in_progress += 1
             self.peak = max(self.peak, self.in_progress)
             self.requests.append(body)
             self.paths.append(path)
-            scripted = self._script.popleft() if self._script else None
-        answer = scripted or (self.default(body, index) if callable(self.default) else self.default)
+            scripted = None if refusal or not self._script else self._script.popleft()
+        answer = refusal or scripted or (self.default(body, index) if callable(self.default) else self.default)
         with self._lock:
             self.served[answer.kind] += 1
         return answer
@@ -187,6 +159,11 @@ class FakeOpenAI:
 
         class Handler(BaseHTTPRequestHandler):
             protocol_version = "HTTP/1.1"  # keep-alive, as real providers do
+
+            def setup(self) -> None:
+                super().setup()
+                with server._lock:
+                    server._connections.add(self.connection)
 
             def log_message(self, *args: object) -> None:  # keep test output quiet
                 pass
@@ -207,11 +184,11 @@ class FakeOpenAI:
                 except json.JSONDecodeError:
                     self._send(400, {"error": {"message": "request body is not JSON"}})
                     return
-                answer = server._next_answer(body, self.path)
+                answer = server._next_answer(body, self.path, self.headers.get("Authorization"))
                 if answer.delay_s and server._stopping.wait(answer.delay_s):
                     sent = False  # the server is shutting down
                 elif answer.status != 200:
-                    sent = self._send(answer.status, _error_body(answer.status), answer.headers)
+                    sent = self._send(answer.status, _error_body(answer.status, answer.message), answer.headers)
                 else:
                     sent = self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
                 server._done(sent)
@@ -240,8 +217,14 @@ def main() -> None:
     parser.add_argument("--delay", type=float, default=0.0)
     parser.add_argument("--bad-rate", type=float, default=0.0)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--mix", nargs="+", default=["malformed", "http_500"], choices=sorted(FAULTS))
+    parser.add_argument("--slow", type=float, default=0.0, help="extra delay of a bad answer, s")
+    parser.add_argument("--api-key", default=None)
+    parser.add_argument("--models", nargs="*", default=None)
+    parser.add_argument("--context-window", type=int, default=None)
     args = parser.parse_args()
-    with FakeOpenAI(default=faulty(args.delay, args.bad_rate, args.seed)) as server:
+    default = faulty(args.delay, args.bad_rate, args.seed, tuple(args.mix), args.slow)
+    with FakeOpenAI(default, args.api_key, args.models and tuple(args.models), args.context_window) as server:
         print(json.dumps({"url": server.url}), flush=True)
         sys.stdin.read()
 

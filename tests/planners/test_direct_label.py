@@ -5,11 +5,11 @@ from __future__ import annotations
 import json
 
 import pytest
-from fake_openai import http_error, ok
+from fake_answers import http_error, ok
 
 from emopose.planners.base import PlanRequest
 from emopose.planners.direct_label import label_from_answer
-from emopose.stages.parse import parse_plan
+from emopose.stages.parse import parse_output, parse_plan
 
 LINE = PlanRequest("It's alright, these things happen to everyone.",
                    history=({"role": "user", "content": "I broke the vase."},))
@@ -33,9 +33,11 @@ def test_label_becomes_one_contract_record(fake_openai, make_label_planner):
     assert plan.source == "model" and [r.cls for r in plan.records] == ["comforting"]
 
 
-def test_unknown_label_is_neutral(fake_openai, make_label_planner):
+def test_an_answer_without_a_label_is_a_counted_fallback(fake_openai, make_label_planner):
     fake_openai.default = ok("I would say it is mostly kind.")
-    assert json.loads(make_label_planner().plan(LINE).raw)["gestures"][0]["class"] == "neutral"
+    plan = parse_output(make_label_planner().plan(LINE), LINE.utterance)
+    assert plan.source == "plain_text" and plan.fallback  # not a silent neutral with confidence 0
+    assert [r.cls for r in plan.records] == ["neutral"] and plan.reply == LINE.utterance  # the line is kept
 
 
 def test_same_data_different_question(fake_openai, make_label_planner):
@@ -56,4 +58,4 @@ def test_shares_the_retry_and_fallback_path(fake_openai, make_label_planner):
     fake_openai.default = http_error(500)
     out = planner.plan(PlanRequest("No, absolutely not."))
     assert out.fallback and parse_plan(out.raw).records[0].cls == "rejecting"
-    assert planner.stats()["retries"] == 1 + 3 and planner.stats()["fallbacks"] == 1
+    assert planner.stats()["retries"] == 1 + 3 and planner.stats()["failed_calls"] == 1

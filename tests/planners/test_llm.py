@@ -6,7 +6,7 @@ import asyncio
 import json
 
 import pytest
-from fake_openai import (
+from fake_answers import (
     PLAN_JSON,
     Answer,
     empty,
@@ -55,7 +55,7 @@ def test_fallback_after_exhausting_retries(fake_openai, make_llm_planner):
     assert out.fallback and "InternalServerError" in out.error and "3 attempt" in out.error
     assert parse_plan(out.raw).records[0].cls == "welcoming"  # keyword baseline answer
     stats = planner.stats()
-    assert (stats["calls"], stats["retries"], stats["fallbacks"]) == (1, 2, 1)
+    assert (stats["calls"], stats["retries"], stats["failed_calls"]) == (1, 2, 1)
 
 
 @pytest.mark.parametrize("status", [400, 401, 404])
@@ -213,4 +213,15 @@ def test_check_reports_missing_key_and_bad_model(make_llm_planner, monkeypatch):
         make_llm_planner(model="no-such-provider/model-x", api_base=None).check()
     make_llm_planner().check()  # a local api_base needs no key
     monkeypatch.setenv("OPENAI_API_KEY", "sk-test")
-    make_llm_planner(api_base=None, model="openai/gpt-4o-mini").check()
+    make_llm_planner(api_base=None, model="openai/gpt-4o-mini", probe=False).check()  # no network here
+
+
+def test_queueing_is_counted_apart_from_server_time(fake_openai, make_llm_planner):
+    fake_openai.default = slow(0.2)
+    planner = make_llm_planner(concurrency=1, cache=False)
+    first, _, last = plan_all(planner, [PlanRequest(f"line {k}") for k in range(3)])
+    assert first.meta["queue_s"] < first.latency_s  # one slot: the first goes straight to the server ...
+    assert last.meta["queue_s"] >= first.latency_s  # ... the last waited while the others held it
+    assert last.latency_s < last.meta["queue_s"]  # its latency is its own call, not the two calls before it
+    stats = planner.stats()
+    assert stats["queue_mean_s"] > 0 and stats["latency_mean_s"] >= 0.2
