@@ -30,9 +30,10 @@ from control_loop import realtime_priority  # benchmarks/ is on sys.path when ru
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
 from emopose.control_loop import ControlLoop
+from emopose.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
-from emopose.sequencer import GestureCommand, Sequencer
+from emopose.sequencer import Sequencer
 from emopose.stages.modulate import modulate_keyframes
 from emopose.trajectory import TrajectoryBuilder
 

@@ -28,8 +28,9 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 from emopose import CONTROL_DT
 from emopose.clock import MonotonicClock
 from emopose.control_loop import ControlLoop
+from emopose.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
-from emopose.sequencer import GestureCommand, Sequencer
+from emopose.sequencer import Sequencer
 from emopose.trajectory import TrajectoryBuilder
 
 LIBRARY = Path(__file__).resolve().parents[1] / "library" / "g1"

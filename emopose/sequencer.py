@@ -24,18 +24,18 @@ rejected, dropped (by the timeline, with its reason), state.
 
 from __future__ import annotations
 
-import itertools
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from enum import StrEnum
 
 import numpy as np
 
 from emopose import STROKE_TOLERANCE
 from emopose.bounded_log import BoundedLog
+from emopose.gesture_command import Event, GestureCommand
 from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 
@@ -44,37 +44,6 @@ class State(StrEnum):
     EXECUTING = "executing"
     HOLDING = "holding"
     BLENDING = "blending"
-
-
-@dataclass(frozen=True)
-class GestureCommand:
-    """A motion to run: intensity-modulated (K, 14) keyframes, duration, earliest start (clock time).
-    A timed command also gives each keyframe's time after release_at (`offsets`, offsets[0] = 0)."""
-
-    name: str
-    keyframes: np.ndarray
-    duration: float
-    release_at: float = float("-inf")
-    label: str = ""
-    id: int = field(default_factory=itertools.count().__next__)
-    record: int | None = None               # index of the plan record it performs, when it comes from a turn
-    stroke: tuple[int, int] | None = None   # keyframe indices of the stroke, for the "stroke" event
-    offsets: tuple[float, ...] | None = None
-    blend_in: bool = False                  # timed: the first segment is a co-articulation blend
-    cut: bool = False                       # timed: planned to end after its stroke (reported as "cut")
-
-    @property
-    def timed(self) -> bool:
-        return self.offsets is not None
-
-
-@dataclass(frozen=True)
-class Event:
-    t: float
-    kind: str  # started, stroke, completed, cut, stopped, rejected, dropped, state
-    name: str = ""
-    command_id: int | None = None
-    detail: str = ""
 
 
 SafetyCheck = Callable[[np.ndarray], "str | None"]

@@ -16,10 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from emopose import STROKE_TOLERANCE
-
 from emopose.control_loop import ControlLoop
+from emopose.gesture_command import Event
 from emopose.recording import read_recording
-from emopose.sequencer import Event
 from emopose.stages.schedule import trigger_position
 from emopose.stroke_sync import PlannedStroke, Streams, StrokeSync, measure_strokes, planned_strokes
 from emopose.turn import Turn

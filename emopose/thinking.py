@@ -20,8 +20,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 from emopose.clock import Clock
+from emopose.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
-from emopose.sequencer import GestureCommand, Sequencer
+from emopose.sequencer import Sequencer
 
 log = logging.getLogger(__name__)
 

@@ -15,7 +15,8 @@ backwards from there. Gestures are placed in the order of their words, each agai
    from rest, time-scaled down to `scale[0]`;
 5. dropped, with the reason, when none of these fits.
 The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
-preparation needs more, it is compressed (down to `scale[0]`) and then lands late ("late").
+preparation needs more, it is compressed (down to `scale[0]`), then shortened to one segment straight
+to the stroke start ("direct", for strokes after several preparation keyframes), and then lands late.
 `lag_s` moves everything earlier to absorb the actuators' tracking lag (0 for a command stream).
 """
 
@@ -157,17 +158,22 @@ class TimelinePlanner:
 
     def _prepare(self, name, anchors, stroke, step, start_pose, blend_in, earliest, aim, scales) -> _Placed | None:
         """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
-        to scales[1]; None if even the fastest preparation would need to start before `earliest`."""
-        for scale in np.unique(np.clip(np.arange(scales[0], scales[1] - 1e-9, -0.05).tolist() + [scales[1]],
-                                       scales[1], scales[0]))[::-1]:
-            durations = self._durations(anchors, start_pose, 0, stroke[0], step * scale, blend_in)
-            arrival_lead = self._approach(start_pose if stroke[0] == 1 else anchors[stroke[0] - 1],
-                                          anchors[stroke[0]], durations[-1], blend_in and stroke[0] == 1)
-            start = aim + arrival_lead - sum(durations)
-            if start >= earliest - 1e-9:
-                fit: Fit = "nominal" if scale == 1.0 else "scaled"
-                return self._finish(name, anchors, stroke, step, start_pose, start, durations, aim, aim, fit,
-                                    blend_in, float(scale))
+        to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
+        start; None if even that would need to start before `earliest`."""
+        shapes = [(anchors, stroke, None)]
+        if stroke[0] >= 2:  # skip the intermediate preparation keyframes
+            shapes.append((np.vstack([anchors[:1], anchors[stroke[0]:]]), (1, stroke[1] - stroke[0] + 1), "direct"))
+        grid = np.arange(scales[0], scales[1] - 1e-9, -0.05).tolist() + [scales[1]]
+        for shape, sync, how in shapes:
+            for scale in np.unique(np.clip(grid, scales[1], scales[0]))[::-1]:
+                durations = self._durations(shape, start_pose, 0, sync[0], step * scale, blend_in)
+                arrival_lead = self._approach(start_pose if sync[0] == 1 else shape[sync[0] - 1],
+                                              shape[sync[0]], durations[-1], blend_in and sync[0] == 1)
+                start = aim + arrival_lead - sum(durations)
+                if start >= earliest - 1e-9:
+                    fit: Fit = how or ("nominal" if scale == 1.0 else "scaled")
+                    return self._finish(name, shape, sync, step, start_pose, start, durations, aim, aim, fit,
+                                        blend_in, float(scale))
         return None
 
     def _late(self, name, anchors, stroke, step, start, aim) -> _Placed:

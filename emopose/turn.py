@@ -14,13 +14,13 @@ from typing import Literal
 import numpy as np
 
 from emopose.contract import GestureRecord, LibraryEntry, Plan
+from emopose.gesture_command import Event, GestureCommand
 from emopose.planners.base import PlannerOutput, PlanRequest
-from emopose.sequencer import Event, GestureCommand
 from emopose.speech.clip import SpeechClip
 
 ResolveRule = Literal["exact", "class_default", "neutral", "gated"]
 ReleaseRule = Literal["anchor", "words", "interpolated", "even", "immediate"]
-Fit = Literal["nominal", "scaled", "coarticulated", "shortened", "late"]
+Fit = Literal["nominal", "scaled", "direct", "coarticulated", "shortened", "late"]
 
 
 @dataclass(frozen=True)

@@ -23,8 +23,9 @@ from tests.conftest import compose_config
 
 DEFAULTS = {group: option for entry in OmegaConf.load(CONFIG_DIR / "config.yaml").defaults
             if isinstance(entry, DictConfig) for group, option in entry.items()}
-UNBUILDABLE = {("planner", "local"): "trains for ~11 min on first use (tests/planners/test_local.py)"}
-CONSUMED_WITH = {"prompt": ["planner=llm"]}  # a group only some options of another group read
+UNBUILDABLE = {("planner", "local"): "trains for ~11 min on first use (tests/planners/test_local.py)",
+               ("planner", "annotate"): "its annotator is planner=local (tests/planners/test_annotate.py)"}
+CONSUMED_WITH = {"prompt": ["planner=llm"], "arm_law": ["backend=mujoco"]}  # read by some options of another group
 
 
 def built_from(node: DictConfig, obj, *settings: str) -> None:
@@ -62,13 +63,22 @@ def safety_hook(cfg, run) -> None:
     assert hook(np.array([inward])) and hook(np.array([run.resources.library.neutral_entry.q[0]])) is None
 
 
+def arm_law_applied_by_the_simulator(cfg, run) -> None:
+    """Not built on its own: the backends read it by interpolation (MuJoCo applies it, G1 sends it)."""
+    law = run.resources.backend.law
+    assert (law.name, law.kp, law.gravity_compensation) == (cfg.arm_law.name, cfg.arm_law.kp,
+                                                            cfg.arm_law.gravity_compensation)
+    assert run.resources.backend.tracking_lag_s == cfg.arm_law.tracking_lag_s
+    assert run.resources.pipeline.get("schedule").timeline.lag_s == cfg.arm_law.tracking_lag_s
+
+
 def prompt_read_by_the_planner(cfg, run) -> None:
     """Not built on its own: the chat planners read it by interpolation (planner/llm.yaml)."""
     raw = OmegaConf.to_container(cfg.planner, resolve=False)
     assert raw["template"] == "${prompt.template}" and raw["demonstrations"] == "${prompt.demonstrations}"
     planner = run.resources.planner
     assert planner.template.path == Path(cfg.prompt.template).expanduser()
-    assert planner.demonstrations == load_demonstrations(cfg.prompt.demonstrations)
+    assert planner.demonstrations == load_demonstrations(cfg.prompt.demonstrations)[:cfg.prompt.max_demonstrations]
 
 
 CONSUMERS = {
@@ -85,6 +95,7 @@ CONSUMERS = {
     "asr": lambda cfg, run: built_from(cfg.asr, run.resources.asr, "model", "api_base", "language"),
     "player": lambda cfg, run: built_from(cfg.player, run.resources.player, "sink", "latency_s"),
     "thinking": lambda cfg, run: built_from(cfg.thinking, run.runner.thinking, "motion", "repeats"),
+    "arm_law": arm_law_applied_by_the_simulator,
 }
 
 
@@ -108,6 +119,8 @@ def test_the_group_is_built_into_the_run(group, option, tmp_path, monkeypatch):
     monkeypatch.setenv("OPENAI_API_KEY", "sk-never-sent")  # hosted planners check for a key; nothing is called
     chosen = {"planner": "keyword", group: option}  # keyword: nothing trains or downloads
     cfg = compose_config([f"{g}={o}" for g, o in chosen.items()] + CONSUMED_WITH.get(group, []))
+    if "probe" in cfg.planner:  # LLM planners probe their endpoint at build; there is no server here
+        cfg.planner.probe = False
     with build_run(cfg, tmp_path) as run:
         consumer(cfg, run)
 

@@ -21,6 +21,9 @@ class Backend(ABC):
     name: ClassVar[str]
     # True: the loop must run on the wall clock (a real robot); False: virtual time is allowed.
     realtime: ClassVar[bool] = False
+    # How long the joints trail the commanded stream (s): motors under their control law. The timeline
+    # plans strokes this much ahead; a backend without actuators (dry run) has none.
+    tracking_lag_s: float = 0.0
 
     @abstractmethod
     def connect(self, recorder: Recorder | None) -> np.ndarray | None:

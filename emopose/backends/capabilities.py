@@ -15,6 +15,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from emopose.robot.arm_law import ArmLaw
+
 
 @runtime_checkable
 class PlanarBase(Protocol):
@@ -43,6 +45,7 @@ class SimulatedState(Protocol):
     planar_base: PlanarBase | None  # attached by config (the tour's base), else None
     renderer: FrameSource  # the attached renderer: its frames, video and PNG output
     max_actuator_force_ratio: float  # peak |joint torque| / limit since connect(); callers may zero it
+    law: ArmLaw  # the arms' motor law its servos apply (emopose/robot/arm_law.py)
 
     def select_gl(self) -> bool:
         """Choose MUJOCO_GL before mujoco's first import; True when a viewer window will open."""
@@ -55,6 +58,9 @@ class SimulatedState(Protocol):
 
     def joint_torques(self) -> np.ndarray:
         """Current (14,) joint torques, N m."""
+
+    def apply_law(self, law: ArmLaw) -> None:
+        """Drive the arms by another motor law from now on (a connected simulator)."""
 
 
 @runtime_checkable

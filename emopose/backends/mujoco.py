@@ -1,11 +1,13 @@
 """MuJoCo backend: the physics of the project's G1 upper-body model under position servos, 50 Hz.
 
 Each send(t, q) is one control period: the 14 targets become the servos' setpoints and physics
-advances CONTROL_DT in `substeps` steps. Gravity is compensated through the actuators (the model's
-body gravcomp + joint actuatorgravcomp), so the compensating torque shares each joint's torque
-limit, as a real motor's would. With velocity_feedforward the servo tracks (q, dq), dq being the
-stream's finite difference, as LowCmd_ hands q and dq to the G1's motor PD; without it a 0.3 rad,
-0.5 Hz sine lags to ~0.014 rad MAE instead of ~0.005. Streams written to the Recorder (the control
+advances CONTROL_DT in `substeps` steps. The servos follow the arm law (emopose/robot/arm_law.py,
+conf/arm_law/): by default the G1's own command law (kp 60, kd 1.5, dq = tau = 0: no gravity
+compensation, no velocity feed-forward), so the arms lag and sag as the robot's do; `arm_law=mjcf`
+restores the MJCF's stiffer servos, gravity compensated through the actuators (body gravcomp + joint
+actuatorgravcomp, so the compensating torque shares each joint's torque limit), tracking (q, dq) with
+dq the stream's finite difference. `apply_law()` switches laws on a connected model (sim_suite
+compares them). Streams written to the Recorder (the control
 loop records the commanded stream, /joints/command, itself):
   /joints/sim      {"t", "q"}  the simulated pose at the end of that period, stamped t + CONTROL_DT
   /joints/torque   {"t", "tau", "ratio"}  joint torque (servo + gravcomp) and max |tau|/limit
@@ -19,6 +21,7 @@ import logging
 import math
 import os
 import threading
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -27,6 +30,8 @@ from emopose.backends.base import Backend
 from emopose.backends.planar_base import MujocoPlanarBase
 from emopose.backends.sim_renderer import SimRenderer
 from emopose.recording import Recorder
+from emopose.robot.arm_law import ArmLaw
+from emopose.robot.feedforward import Feedforward, GravityModel
 from emopose.robot.g1_spec import CONTROL_DT, JOINT_NAMES, NUM_JOINTS
 from emopose.robot.model import build_model
 
@@ -44,8 +49,8 @@ class MujocoBackend(Backend):
         substeps: int | None = None,
         timestep: float | None = None,
         initial_pose: list[float] | None = None,
-        velocity_feedforward: bool = True,
-        max_feedforward_velocity: float = 4.0,
+        law: ArmLaw | None = None,
+        tracking_lag_s: float = 0.0,
         renderer: SimRenderer | None = None,
         planar_base: MujocoPlanarBase | None = None,
         viewer: bool = False,
@@ -61,8 +66,9 @@ class MujocoBackend(Backend):
         self.initial_pose = (
             np.zeros(NUM_JOINTS) if initial_pose is None else np.asarray(initial_pose, float)
         )
-        self.velocity_feedforward = velocity_feedforward
-        self.max_feedforward_velocity = max_feedforward_velocity
+        # Built without a law (code, not config): the servos as the model file declares them.
+        self.law = law or ArmLaw("mjcf", None, None, velocity_feedforward=True, gravity_compensation=True)
+        self.tracking_lag_s = tracking_lag_s
         self.renderer = renderer or SimRenderer()  # on-demand frames only, unless configured
         self.planar_base = planar_base
         self.viewer = viewer
@@ -105,12 +111,14 @@ class MujocoBackend(Backend):
         self._act = np.array([m.actuator(n).id for n in JOINT_NAMES])
         self._lo, self._hi = m.jnt_range[[j.id for j in joints]].T
         self._tau_limit = m.jnt_actfrcrange[[j.id for j in joints], 1]
-        # kv/kp turns a velocity reference into a setpoint offset: kp(q*+kv/kp v*-q) - kv qd.
-        self._kv_over_kp = -m.actuator_biasprm[self._act, 2] / m.actuator_gainprm[self._act, 0]
+        self._mjcf_servos = (m.actuator_gainprm[self._act, 0].copy(), -m.actuator_biasprm[self._act, 2].copy())
+        self._mjcf_gravcomp = (m.body_gravcomp.copy(), m.jnt_actgravcomp.copy())
+        self._gravity = GravityModel(self.model_path)
+        self.apply_law(self.law)
         q0 = np.clip(self.initial_pose, self._lo, self._hi)
         self.data.qpos[self._qadr] = q0
         self.data.ctrl[self._act] = q0
-        self._last_target = q0.copy()
+        self._feedforward.reset(q0)
         mujoco.mj_forward(m, self.data)
         self._recorder, self._tick = recorder, 0
         self.max_actuator_force_ratio = 0.0
@@ -127,17 +135,10 @@ class MujocoBackend(Backend):
         if self.data is None:
             raise RuntimeError("mujoco backend: send() before connect()")
         target = np.clip(np.asarray(q, dtype=float).reshape(NUM_JOINTS), self._lo, self._hi)
-        setpoint = target
-        if self.velocity_feedforward:
-            # The G1 motor PD takes (q, dq); the stream's finite difference supplies dq. Capped so a
-            # step command does not turn into a velocity spike.
-            v = np.clip(
-                (target - self._last_target) / CONTROL_DT,
-                -self.max_feedforward_velocity,
-                self.max_feedforward_velocity,
-            )
-            setpoint = target + self._kv_over_kp * v
-        self._last_target = target
+        dq, tau = self._feedforward(target)
+        # A position servo makes kp (ctrl - q) - kv qd, so the robot's kp (q* - q) + kd (dq* - qd) + tau_ff
+        # is ctrl = q* + (kd dq* + tau_ff) / kp.
+        setpoint = target + (self._kv * dq + tau) / self._kp
         with self._lock:
             self.data.ctrl[self._act] = setpoint
             ratio = 0.0
@@ -158,6 +159,26 @@ class MujocoBackend(Backend):
         if self._viewer is not None and self._viewer.is_running():
             self._viewer.sync()
 
+    def apply_law(self, law: ArmLaw) -> None:
+        """Servo gains and feed-forwards of `law`. Without gains it keeps the MJCF's own servos, whose
+        gravity compensation the model applies itself (body gravcomp) instead of a tau_ff."""
+        m = self.model
+        own = law.model_servos
+        kp, kv = self._mjcf_servos if own else (law.gains(law.kp), law.gains(law.kd))
+        with self._lock:
+            m.actuator_gainprm[self._act, 0] = kp  # position servo: kp (ctrl - q) - kv dq
+            m.actuator_biasprm[self._act, 1] = -kp
+            m.actuator_biasprm[self._act, 2] = -kv
+            builtin = own and law.gravity_compensation
+            bodies, joints = self._mjcf_gravcomp
+            m.body_gravcomp[:] = bodies if builtin else 0.0
+            m.jnt_actgravcomp[:] = joints if builtin else 0
+        self._kp, self._kv = np.maximum(kp, 1e-9), kv
+        fed = replace(law, gravity_compensation=False) if own else law
+        self._feedforward = Feedforward(fed, self._gravity if law.gravity_compensation and not own else None)
+        self._feedforward.reset(self.data.qpos[self._qadr])
+        self.law = law
+
     def reset(self, q: np.ndarray) -> np.ndarray:
         """Put the arms at rest at q (clipped to range) with the servos holding it: lets library
         checks and replays start each run from a known pose without reconnecting."""
@@ -169,7 +190,7 @@ class MujocoBackend(Backend):
             self.data.qpos[self._qadr] = q
             self.data.ctrl[self._act] = q
             self._mj.mj_forward(self.model, self.data)
-        self._last_target = q.copy()
+        self._feedforward.reset(q)
         self.max_actuator_force_ratio = 0.0
         return self.measured()
 

@@ -45,7 +45,16 @@ def suite_markdown(r: dict) -> str:
         "class_range": "Per-class MAE range", "vlm": "VLM inference mean / P95",
         "construction": "Trajectory construction mean / P95", "submission": "Command submission mean / P95",
     }
-    table = markdown_table(["Metric", "Paper", "This run"], [[labels[k], PAPER[k], ours[k]] for k in labels])
+    paper = dict(PAPER)
+    if r.get("arm_law"):
+        labels["mae"] += f" under the {r['arm_law']} arm law"
+    if r.get("compare"):  # right below the configured law's MAE
+        c = r["compare"]
+        at = list(labels).index("mae") + 1
+        labels = dict([*list(labels.items())[:at], ("compare", f"... under the {c['arm_law']} arm law"),
+                       *list(labels.items())[at:]])
+        ours["compare"], paper["compare"] = f"{c['mae_rad']:.5f} rad ({c['mae_deg']:.2f} deg)", "-"
+    table = markdown_table(["Metric", "Paper", "This run"], [[labels[k], paper[k], ours[k]] for k in labels])
     classes = markdown_table(
         ["class", "motion", "MAE tick (rad)", "MAE time-aligned (rad)", "max force ratio"],
         [[c, r["motions"][c], f"{r['per_class_mae_rad'][c]:.5f}", f"{r['per_class_mae_time_aligned_rad'][c]:.5f}",

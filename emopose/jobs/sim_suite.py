@@ -7,7 +7,9 @@ and simulated time agree. A session does not reset the robot between utterances:
 where the previous one left the arms (its held end pose), or, on alternate trials, after the
 sequencer's own 2 s hold + 1 s recovery to neutral. Completion = a "completed" event for the trial's
 command without a stop request, a safety rejection or a dispatch timeout. Tracking per
-emopose/jobs/tracking.py (tick alignment, N resampled points, Eq. sim-MAE).
+emopose/jobs/tracking.py (tick alignment, N resampled points, Eq. sim-MAE). With `compare_law` the
+same trials run again with the simulator's servos under that arm law (the MJCF's own, say), so the
+results show how much the configured law (the robot's, by default) costs in tracking.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from emopose.jobs.report import write_results
 from emopose.jobs.sim_report import suite_markdown
 from emopose.jobs.tracking import StreamTap, latency_ms, sim_mae, tracking_error
 from emopose.resources import Run
+from emopose.robot.arm_law import ArmLaw
 from emopose.sequencer import State
 
 log = logging.getLogger(__name__)
@@ -39,6 +42,7 @@ class SimSuiteJob:
     points: int = 100
     seed: int = 0
     rest_timeout_s: float = 10.0
+    compare_law: ArmLaw | None = None
 
     def __post_init__(self) -> None:
         if self.trials < len(CLASSES) or self.trials % len(CLASSES):
@@ -62,10 +66,26 @@ class SimSuiteJob:
         t0 = res.clock.now() - loop.stream_time
         rows = [self._trial(run, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
         results = self._summarise(run, rows)
+        simulator = res.backend if isinstance(res.backend, SimulatedState) else None
+        results["arm_law"] = None if simulator is None else simulator.law.name
+        if simulator is not None and self.compare_law is not None:
+            results["compare"] = self._under(run, tap, t0, order, motions, simulator, self.compare_law)
         write_results(res.run_dir, results, suite_markdown(results))
         (res.run_dir / "trials.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
         print(suite_markdown(results).split("\n\n")[1])
         return results
+
+    def _under(self, run: Run, tap: StreamTap, t0: float, order, motions, simulator, law: ArmLaw) -> dict:
+        """The same trials with the servos under `law`; the configured law is restored after."""
+        configured = simulator.law
+        simulator.apply_law(law)
+        try:
+            rows = [self._trial(run, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
+        finally:
+            simulator.apply_law(configured)
+        summary = self._summarise(run, rows)
+        keys = ("completed", "mae_rad", "mae_deg", "per_class_mae_rad", "mae_time_aligned_rad", "max_abs_error_rad")
+        return {"arm_law": law.name, **{k: summary[k] for k in keys}}
 
     def _start_mode(self, k: int) -> str:
         if self.start_from == "alternate":

@@ -17,7 +17,8 @@ import time
 from dataclasses import dataclass, field
 
 from emopose.clock import Clock
-from emopose.sequencer import GestureCommand, Sequencer
+from emopose.gesture_command import GestureCommand
+from emopose.sequencer import Sequencer
 from emopose.speech.player import Player
 from emopose.turn import ModulatedGesture, Release, Submission, Turn
 

@@ -18,10 +18,10 @@ import numpy as np
 
 from emopose.backends.capabilities import PlanarBase, SimulatedState
 from emopose.contract import LibraryEntry
+from emopose.gesture_command import GestureCommand
 from emopose.jobs.report import markdown_table, write_results
 from emopose.resources import Run
 from emopose.robot.kinematics import HAND_ORIGIN
-from emopose.sequencer import GestureCommand
 from emopose.session import Session
 from emopose.tour.aim import AimStage, peak_indices
 from emopose.tour.geometry import Pose2D, angle_between, map_to_torso, torso_to_map

@@ -8,7 +8,8 @@ import pytest
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
 from emopose.control_loop import ControlLoop
-from emopose.sequencer import GestureCommand, Sequencer, State
+from emopose.gesture_command import GestureCommand
+from emopose.sequencer import Sequencer, State
 from emopose.trajectory import TrajectoryBuilder
 
 

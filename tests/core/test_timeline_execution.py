@@ -11,7 +11,8 @@ from hypothesis import strategies as st
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
 from emopose.control_loop import ControlLoop
-from emopose.sequencer import GestureCommand, Sequencer, State
+from emopose.gesture_command import GestureCommand
+from emopose.sequencer import Sequencer, State
 from emopose.stages.sequence import SequenceStage
 from emopose.timeline import TimelinePlanner, TimelineSettings
 from emopose.trajectory import TrajectoryBuilder

@@ -26,7 +26,8 @@ def test_library_check_two_g1_motions(tmp_path):
         assert sorted(motion["levels"]) == ["1", "2", "3", "4", "5"]
         assert motion["min_margin_rad"] > 0  # commands never reach a hard limit (projection)
         assert motion["max_force_ratio"] <= 1.0 + 1e-9
-        assert motion["levels"]["3"]["mae_rad"] < 0.01 and not motion["levels"]["3"]["contacts"]
+        # tracked under the G1's own law (kp 60, kd 1.5, no feed-forward): it lags and sags ~0.01-0.02 rad
+        assert motion["levels"]["3"]["mae_rad"] < 0.02 and not motion["levels"]["3"]["contacts"]
         if sheets:
             assert (tmp_path / "sheets" / f"{name}.png").stat().st_size > 1000
     if sheets:

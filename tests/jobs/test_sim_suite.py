@@ -17,7 +17,8 @@ from emopose.recording import read_recording
 from emopose.trajectory import TrajectoryBuilder
 from tests.jobs.sim_helpers import compose_config
 
-TRACKING_BOUND_RAD = 0.010  # the suite's MAE target, per class default at level 3
+TRACKING_BOUND_RAD = 0.010  # the suite's MAE target, per class default at level 3, under the MJCF's servos
+ROBOT_LAW_BOUND_RAD = 0.020  # the same under the G1's own law (kp 60, kd 1.5, no feed-forward)
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +54,11 @@ def test_sim_suite_eight_trials_end_to_end(tmp_path):
     assert saved["trials"] == saved["completed"] == 8
     assert saved["stops"] == saved["timeouts"] == saved["rejected"] == 0
     assert set(saved["per_class_mae_rad"]) == set(CLASSES)  # 8 trials = one per class
-    assert 0 < saved["mae_rad"] <= TRACKING_BOUND_RAD
+    # Under the G1's command law (the default) the simulator tracks like the robot: several times worse
+    # than the MJCF's own stiffer, gravity-compensated servos, which the suite runs again for comparison.
+    assert saved["arm_law"] == "robot" and saved["compare"]["arm_law"] == "mjcf"
+    assert 0 < saved["compare"]["mae_rad"] <= TRACKING_BOUND_RAD and saved["compare"]["completed"] == 8
+    assert 2 * saved["compare"]["mae_rad"] < saved["mae_rad"] <= ROBOT_LAW_BOUND_RAD
     assert saved["mae_time_aligned_rad"] > saved["mae_rad"]  # wall-clock pairing adds a period of lag
     assert saved["max_actuator_force_ratio"] <= 1.0 + 1e-9
     for key in ("construction_ms", "submission_ms"):

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from emopose.backends.dry_run import DryRunBackend
+from emopose.gesture_command import GestureCommand
 from emopose.planners.base import PlannerOutput
-from emopose.sequencer import GestureCommand
 from emopose.thinking import ThinkingGesture
 from tests.wiring import wire
 

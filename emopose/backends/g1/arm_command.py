@@ -1,6 +1,7 @@
 """Builds the LowCmd_ that goes on rt/arm_sdk: arm targets, arm_sdk weight, gains, CRC.
 
-Only motors 15-28 (and, when asked, the waist 12-14) get mode=1, q, dq=0, tau=0, kp, kd;
+Only motors 15-28 (and, when asked, the waist 12-14) get mode=1, q, kp, kd, and the arm law's
+dq and tau feed-forwards (0 under the default law, as Unitree's arm example sends them);
 motor 29 carries the weight in its q; every other motor stays all-zero so the firmware keeps
 the legs. One preallocated record is reused: a command costs a few vectorised assignments,
 a ~7 us CRC and a byte copy, which keeps send() far below the 20 ms tick.
@@ -33,17 +34,21 @@ class ArmCommandBuilder:
         motors["mode"][_ARM] = 1
         motors["kp"][_ARM] = kp
         motors["kd"][_ARM] = kd
-        # dq, tau and reserve stay 0: pure position targets, as Unitree's arm example sends them.
+        # reserve stays 0; dq and tau are written per command (the arm law's feed-forwards)
         if waist_q is not None:
             motors["mode"][_WAIST] = 1
             motors["q"][_WAIST] = waist_q
             motors["kp"][_WAIST] = waist_kp
             motors["kd"][_WAIST] = waist_kd
-        self._q = motors["q"]  # view into the record: writes land in the message directly
+        self._q, self._dq, self._tau = motors["q"], motors["dq"], motors["tau"]  # views: writes land in the message
 
-    def build(self, q: np.ndarray, weight: float) -> tuple[bytes, int]:
-        """Return (CDR bytes for DataWriter, crc) for arm targets q (14,) and weight in [0, 1]."""
+    def build(self, q: np.ndarray, weight: float, dq: np.ndarray | None = None,
+              tau: np.ndarray | None = None) -> tuple[bytes, int]:
+        """Return (CDR bytes for DataWriter, crc) for arm targets q (14,), weight in [0, 1] and the
+        feed-forwards dq, tau (14,) (None: 0)."""
         self._q[_ARM] = q
+        self._dq[_ARM] = 0.0 if dq is None else dq
+        self._tau[_ARM] = 0.0 if tau is None else tau
         self._q[WEIGHT_MOTOR] = min(max(float(weight), 0.0), 1.0)
         crc = wire.set_crc(self.record)
         return wire.lowcmd_to_cdr(self.record), crc
@@ -63,6 +68,8 @@ def decode_arm_command(record: np.ndarray) -> dict:
         "mode": motors["mode"][_ARM].astype(int).tolist(),
         "kp": motors["kp"][_ARM].astype(float).tolist(),
         "kd": motors["kd"][_ARM].astype(float).tolist(),
+        "dq": motors["dq"][_ARM].astype(float).tolist(),
+        "tau": motors["tau"][_ARM].astype(float).tolist(),
         "waist_mode": motors["mode"][_WAIST].astype(int).tolist(),
         "waist_q": motors["q"][_WAIST].astype(float).tolist(),
         "others_zero": others_zero,

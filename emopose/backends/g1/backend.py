@@ -59,10 +59,14 @@ class G1Backend(Backend):
         command_waist: bool = False,
         waist_kp: float = 60.0,
         waist_kd: float = 1.5,
+        velocity_feedforward: bool = False,
+        gravity_compensation: bool = False,
+        tracking_lag_s: float = 0.0,
         clock: Clock | None = None,
     ) -> None:
+        self.tracking_lag_s = tracking_lag_s
         self.settings = G1Settings.build(
-            **{k: v for k, v in locals().items() if k not in ("self", "clock")}
+            **{k: v for k, v in locals().items() if k not in ("self", "clock", "tracking_lag_s")}
         )
         self._clock = clock or MonotonicClock()
         self._life = Lifecycle()

@@ -18,6 +18,8 @@ from emopose.backends.g1.errors import G1ConnectionError
 from emopose.backends.g1.hg_types import LowCmd_
 from emopose.backends.g1.settings import G1Settings
 from emopose.backends.g1.state_monitor import LowStateMonitor
+from emopose.robot.arm_law import ArmLaw
+from emopose.robot.feedforward import Feedforward
 
 log = logging.getLogger(__name__)
 
@@ -34,6 +36,9 @@ class G1Link:
             self.session.close()
             raise
         self._builder: ArmCommandBuilder | None = None
+        law = ArmLaw("g1", settings.kp.tolist(), settings.kd.tolist(), settings.velocity_feedforward,
+                     settings.gravity_compensation)
+        self._feedforward = Feedforward(law)  # dq and tau of every command, as MuJoCo applies them
 
     def where(self) -> str:
         return self.session.describe()
@@ -57,11 +62,13 @@ class G1Link:
             )
         waist = monitor.waist_q() if s.command_waist else None
         self._builder = ArmCommandBuilder(s.kp, s.kd, waist, s.waist_kp, s.waist_kd)
-        return monitor.arm_q()
+        measured = monitor.arm_q()
+        self._feedforward.reset(measured)
+        return measured
 
     def publish(self, q: np.ndarray, weight: float) -> int:
         """Build, CRC and write one LowCmd_; returns the CRC. Not thread-safe (backend locks)."""
-        cdr, crc = self._builder.build(q, weight)
+        cdr, crc = self._builder.build(q, weight, *self._feedforward(q))
         self._writer.write(cdr)
         return crc
 

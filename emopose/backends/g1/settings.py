@@ -55,6 +55,8 @@ class G1Settings:
     command_waist: bool
     waist_kp: float
     waist_kd: float
+    velocity_feedforward: bool = False  # LowCmd dq: the stream's finite difference (else 0)
+    gravity_compensation: bool = False  # LowCmd tau: the model's gravity torque at the target (else 0)
 
     @classmethod
     def build(cls, **kw: object) -> G1Settings:
@@ -95,4 +97,6 @@ class G1Settings:
             command_waist=bool(kw["command_waist"]),
             waist_kp=_positive("waist_kp", kw["waist_kp"], allow_zero=True),
             waist_kd=_positive("waist_kd", kw["waist_kd"], allow_zero=True),
+            velocity_feedforward=bool(kw["velocity_feedforward"]),
+            gravity_compensation=bool(kw["gravity_compensation"]),
         )

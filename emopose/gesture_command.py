@@ -1,0 +1,44 @@
+"""What the sequencer is handed (a GestureCommand) and what it reports (an Event).
+
+A command is a motion to run: intensity-modulated keyframes, a duration and an earliest start on the
+control clock (the paper's FIFO-with-release behaviour); a timed command (the timeline) also fixes
+every keyframe's time. Events name the command they concern.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class GestureCommand:
+    """A motion to run: intensity-modulated (K, 14) keyframes, duration, earliest start (clock time).
+    A timed command also gives each keyframe's time after release_at (`offsets`, offsets[0] = 0)."""
+
+    name: str
+    keyframes: np.ndarray
+    duration: float
+    release_at: float = float("-inf")
+    label: str = ""
+    id: int = field(default_factory=itertools.count().__next__)
+    record: int | None = None               # index of the plan record it performs, when it comes from a turn
+    stroke: tuple[int, int] | None = None   # keyframe indices of the stroke, for the "stroke" event
+    offsets: tuple[float, ...] | None = None
+    blend_in: bool = False                  # timed: the first segment is a co-articulation blend
+    cut: bool = False                       # timed: planned to end after its stroke (reported as "cut")
+
+    @property
+    def timed(self) -> bool:
+        return self.offsets is not None
+
+
+@dataclass(frozen=True)
+class Event:
+    t: float
+    kind: str  # started, stroke, completed, cut, stopped, rejected, dropped, state
+    name: str = ""
+    command_id: int | None = None
+    detail: str = ""
