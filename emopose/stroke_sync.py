@@ -125,3 +125,15 @@ def stroke_summary(rows: list[StrokeSync], simulated: bool = False) -> dict:
         "preroll_p95_ms": float(np.percentile(prerolls, 95)),
         "window_ms": [low, high],
     }
+
+
+def unmet_targets(summary: dict, targets: dict[str, float]) -> list[str]:
+    """Which targets ({"within_window_share": minimum, the other keys: maxima}) a stroke summary misses."""
+    def misses(key: str, bound: float) -> bool:
+        value = summary[key]
+        if value is None:
+            return True
+        return value < bound if key == "within_window_share" else value > bound
+
+    return [f"{key} {summary[key]} vs {bound}" for key, bound in targets.items() if misses(key, bound)]
+

@@ -212,3 +212,12 @@ def test_neutral_poses(library):
         ready["tip"][:, 0] > 0.3
     )  # forearms forward
     assert abs(library.get("neutral_ready").q[0, 3]) < 0.2  # elbow ~90 degrees
+
+
+def test_every_shipped_motion_declares_its_stroke(library):
+    """Authored, not derived: each sequence says where its stroke starts and ends (library/README.md)."""
+    sequences = [e for e in library.snapshot.entries.values() if e.motion_type == "sequence"]
+    assert len(sequences) == 29 and all(e.stroke is not None for e in sequences)
+    for entry in sequences:  # the stroke starts at a real excursion of the motion, not near its rest
+        excursion = np.max(np.abs(entry.q - entry.q[0]), axis=1)
+        assert excursion[entry.stroke[0]] >= 0.5 * excursion.max(), entry.name

@@ -32,7 +32,14 @@ from emopose.pipeline import Pipeline
 from emopose.resources import Resources, Run
 from emopose.runner import TurnRunner
 from emopose.speech.espeak import EspeakSynthesizer
-from emopose.stroke_sync import Streams, StrokeSync, measure_strokes, planned_strokes, stroke_summary
+from emopose.stroke_sync import (
+    Streams,
+    StrokeSync,
+    measure_strokes,
+    planned_strokes,
+    stroke_summary,
+    unmet_targets,
+)
 
 log = logging.getLogger(__name__)
 
@@ -45,6 +52,7 @@ class SyncEvalJob:
     limit: int | None = None
     target_p95_ms: float = 60.0  # words mode, scheduled vs onset
     plots: int = 4               # items drawn as timelines per mode
+    stroke_targets: dict[str, float] = field(default_factory=dict)  # stroke_summary key -> bound (see yaml)
 
     def __call__(self, run: Run) -> dict:
         res = run.resources
@@ -113,9 +121,9 @@ class SyncEvalJob:
                  simulated: bool) -> dict:
         summaries = {mode: summarize(r) for mode, r in rows.items()}
         for mode, stroke_rows in strokes.items():
-            summaries[mode]["stroke_vs_onset"] = stroke_summary(stroke_rows)
-            if simulated:
-                summaries[mode]["stroke_vs_onset_simulated"] = stroke_summary(stroke_rows, simulated=True)
+            for key, sim in (("stroke_vs_onset", False), ("stroke_vs_onset_simulated", True))[:1 + simulated]:
+                summary = stroke_summary(stroke_rows, simulated=sim)
+                summaries[mode][key] = {**summary, "unmet_targets": unmet_targets(summary, self.stroke_targets)}
         missing = [{"item": r.item, "k": r.k, "trigger": r.trigger}
                    for r in next(iter(rows.values()), []) if not r.found]
         for m in missing:
@@ -128,6 +136,7 @@ class SyncEvalJob:
             "control_dt_s": run.session.loop.dt, "modes": summaries,
             "target": {"words_p95_scheduled_vs_onset_ms": self.target_p95_ms, "value_ms": words_p95,
                        "met": words_p95 is not None and words_p95 <= self.target_p95_ms},
+            "stroke_targets": self.stroke_targets,
             "say_do": {"missing": len(missing), "records": missing},
             "gestures": {mode: [r.as_json() for r in mode_rows] for mode, mode_rows in rows.items()},
             "strokes": {mode: [r.as_json() for r in mode_rows] for mode, mode_rows in strokes.items()},
@@ -149,7 +158,7 @@ class SyncEvalJob:
                          ms(unq, "p95_abs_ms"), s["queued"], ms(s["queue_delay"], "mean_abs_ms"),
                          ms(s["scheduled_vs_center"], "p95_abs_ms")])
         stroke_header = ["mode", "stream", "planned", "arrived", "within [-200, +100] ms", "median |offset| (ms)",
-                         "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)"]
+                         "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)", "targets"]
         stroke_rows = []
         for mode, s in results["modes"].items():
             for stream, key in (("command", "stroke_vs_onset"), ("simulated", "stroke_vs_onset_simulated")):
@@ -157,7 +166,8 @@ class SyncEvalJob:
                     st = s[key]
                     stroke_rows.append([mode, stream, st["n"], st["arrived"], f"{st['within_window_share']:.3f}",
                                         ms(st, "median_abs_ms"), ms(st, "p95_abs_ms"), ms(st, "median_signed_ms"),
-                                        f"{st['dropped_share']:.3f}", f"{st['preroll_p95_ms']:.0f}"])
+                                        f"{st['dropped_share']:.3f}", f"{st['preroll_p95_ms']:.0f}",
+                                        "met" if not st["unmet_targets"] else "missed"])
         target = results["target"]
         say_do = results["say_do"]
         flagged = ", ".join(f"{m['item']}#{m['k']} {m['trigger']!r}" for m in say_do["records"]) or "none"
@@ -166,7 +176,8 @@ class SyncEvalJob:
                 f"rate {results['tts']['rate']} wpm).\n\n{markdown_table(header, rows)}\n\n"
                 "## Where the executed strokes land\n\nExecuted stroke start: the first tick at which the stream "
                 "comes within 0.05 rad of the gesture's stroke-start keyframe; offset from the trigger word's onset "
-                f"(negative: before it).\n\n{markdown_table(stroke_header, stroke_rows)}\n\n"
+                f"(negative: before it). Targets (within: at least; the others: at most): "
+                f"{results['stroke_targets']}.\n\n{markdown_table(stroke_header, stroke_rows)}\n\n"
                 f"Target: words-mode p95 |scheduled - onset| <= {target['words_p95_scheduled_vs_onset_ms']:.0f} ms: "
                 f"{'met' if target['met'] else 'NOT met'} ({target['value_ms']}).\n\n"
                 f"Say-do check: {say_do['missing']} record(s) whose trigger is not in the reply: {flagged}.\n\n"

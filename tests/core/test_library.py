@@ -53,3 +53,27 @@ def test_unreadable_yaml_and_duplicate_names(tmp_path):
 def test_duration_rule(library):
     assert library.get("agreeing_a").default_duration == 1.0  # clip(0.3 * 3, 1, 5)
     assert library.get("agreeing_b").default_duration == 1.5  # explicit
+
+
+@pytest.mark.parametrize("stroke, needle", [([0, 1], "1 <= start <= end <= 1"), ([1, 3], "<= 1"),
+                                            ([2, 1], "1 <= start <= end")])
+def test_a_stroke_out_of_range_names_the_file_and_the_rule(tmp_path, stroke, needle):
+    folder = make_library_dir(tmp_path / "library")
+    raised = list(REST)
+    raised[7] -= 0.5
+    write_motion(folder, "bad_stroke", "pointing", [REST, raised, REST], stroke=stroke)
+    with pytest.raises(LibraryError, match="bad_stroke") as caught:
+        load_library(folder)
+    assert "stroke" in str(caught.value) and needle in str(caught.value)
+
+
+def test_a_motion_without_a_stroke_gets_the_largest_excursion_with_a_warning(tmp_path, caplog):
+    folder = make_library_dir(tmp_path / "library")
+    small, large = list(REST), list(REST)
+    small[7] -= 0.3
+    large[7] -= 0.9
+    write_motion(folder, "no_stroke", "pointing", [REST, small, large, small, REST])
+    library = load_library(folder)
+    assert library.get("no_stroke").stroke is None and library.get("no_stroke").stroke_span == (2, 2)
+    assert "no_stroke.yaml: no `stroke" in caplog.text
+    assert library.get("neutral_rest").stroke_span == (0, 0)  # a pose is its own stroke

@@ -150,3 +150,32 @@ def test_random_timelines_and_interrupts_keep_the_stream_continuous(g1, picks, i
     lower, upper = g1.limits.lower, g1.limits.upper
     q = np.array([s[1] for s in rig.stream])
     assert np.all(q >= lower - 1e-9) and np.all(q <= upper + 1e-9)
+
+
+def test_an_interrupt_mid_stroke_blends_from_the_published_pose_and_clears_the_rest(g1):
+    rig = Rig(g1)
+    rig.submit([gesture(g1, "face_wave"), gesture(g1, "shrug")], [1.0, 4.0], speech_start=0.4)
+    while not rig.events("stroke"):
+        rig.run(rig.loop.dt)
+    rig.run(0.3)  # inside the wave's stroke
+    rig.sequencer.interrupt([], now=rig.clock.now())
+    assert rig.sequencer.pending == [] and rig.events("stopped")[0].name == "face_wave"
+    rig.run(4.0)
+    assert rig.sequencer.state == State.IDLE and np.allclose(rig.sequencer.last, rig.rest, atol=1e-9)
+    assert [e.name for e in rig.events("started")] == ["face_wave"]  # the shrug never started
+    assert np.all(rig.steps() <= g1.limits.max_velocity * rig.loop.dt + 1e-9)
+
+
+def test_a_reply_whose_triggers_are_missing_still_gets_a_timeline(g1, tmp_path):
+    from emopose.contract import GestureRecord, Plan
+    from tests.wiring import wire
+
+    wired = wire(g1, tmp_path, mode="timeline")
+    records = [GestureRecord(cls="welcoming", variant="face_wave", trigger="not said"),
+               GestureRecord(cls="pointing", variant="point_left", trigger="nor this")]
+    with wired.session:
+        turn = wired.runner.run_plan(Plan.scripted("Good morning, the tour starts in five minutes.", *records))
+    releases = turn.schedule.releases
+    assert [r.how for r in releases] == ["even", "even"] and not any(r.trigger_found for r in releases)
+    assert all(r.timing is not None for r in releases)  # placed on the anchor equation's even spacing
+    assert [e.name for e in turn.dispatched.events if e.kind == "stroke"] == ["face_wave", "point_left"]

@@ -65,6 +65,9 @@ def test_chat_reply_cues_and_a_moving_simulation_view(page, server):
     page.wait_for_timeout(700)
     assert view.screenshot() != first, "the simulation view did not change while a gesture ran"
     expect(bubble.locator(".cue.fired")).to_have_count(3, timeout=15_000)
+    # each cue shows where its stroke was planned on the word, then where the robot actually put it
+    expect(bubble.locator(".cue .time").first).to_contain_text("stroke")
+    expect(bubble.locator(".cue .time").first).to_contain_text("executed", timeout=15_000)
     SHOTS.mkdir(exist_ok=True)
     page.screenshot(path=str(SHOTS / f"chat_{server['backend']}.png"))
 
