@@ -26,8 +26,15 @@ class BoundedLog(Generic[T]):
 
     def since(self, cursor: int) -> list[T]:
         """The retained entries appended at or after position `cursor` (a past value of `total`)."""
-        start = self.total - len(self._items)
-        return list(self._items)[max(cursor - start, 0):]
+        return self.read(cursor)[0]
+
+    def read(self, cursor: int) -> tuple[list[T], int]:
+        """(the entries since `cursor`, the cursor to read on from), consistent while a writer appends."""
+        while True:
+            total = self.total
+            items = list(self._items)
+            if total == self.total:  # no append in between: items end at position total
+                return items[max(cursor - (total - len(items)), 0):], total
 
     def recent(self, count: int) -> list[T]:
         return self.since(self.total - count)

@@ -2,7 +2,7 @@
 
 Turns (planning, TTS, the pipeline) run through the run's TurnRunner on one worker thread, so the event
 loop never blocks and turns never overlap (the dialogue history is appended in order); the control
-loop ticks on its own thread.
+loop ticks on its own thread. A streamed reply publishes each sentence as a turn once it is handed over.
 Everything a page must hear about (turns, interruptions, saved motions) goes into one bounded log
 with increasing ids; each WebSocket sends what it has not sent yet, so every open page agrees.
 A turn is published before its gestures start; when the sequencer later rejects or drops one, the
@@ -80,7 +80,11 @@ class LiveSession:
 
     def _say(self, text: str, image: bytes | None) -> dict:
         self.publish({"type": "turn_started", "utterance": text})
-        return self._publish_turn(self.run.runner.run(text, image), "say")
+        published: list[dict] = []
+        reply = self.run.runner.respond(text, image, lambda turn: published.append(self._publish_turn(turn, "say")))
+        whole = published and reply.error is None and not reply.cancelled
+        return published[-1] if whole else self.publish({"type": "reply_stopped", "error": reply.error,
+                                                         "cancelled": reply.cancelled, "sentences": len(published)})
 
     def _gesture(self, name: str, intensity: int, text: str | None) -> dict:
         """One record naming the variant, from resolve to dispatch like any plan (no planner call)."""
@@ -160,6 +164,7 @@ class LiveSession:
                 self.publish(update)
 
     def interrupt(self) -> dict:
+        self.run.runner.cancel()  # a reply still streaming stops first: no sentence after this one
         self.res.sequencer.interrupt([], now=self.res.clock.now())
         self.res.player.stop()
         return self.publish({"type": "interrupted"})
@@ -194,7 +199,7 @@ class LiveSession:
         self._track_outcomes()
         now = clock.now()
         active = seq.active
-        events = seq.events.since(events_from)
+        events, events_next = seq.events.read(events_from)
         session = self.run.session
         return {
             "type": "state", "server_now": now, "state": seq.state.value,
@@ -202,7 +207,7 @@ class LiveSession:
             "pending": [{"name": c.name, "label": c.label, "release_in_s": round(c.release_at - now, 3)}
                         for c in seq.pending],
             "events": [{"t": e.t, "kind": e.kind, "name": e.name, "detail": e.detail} for e in events],
-            "events_next": events_from + len(events),
+            "events_next": events_next,
             "loop": None if not session.is_open else {"running": session.loop.running,
                                                       "ticks": session.loop.stats.ticks,
                                                       "missed": session.loop.stats.missed_deadlines},

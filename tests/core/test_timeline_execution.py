@@ -114,16 +114,6 @@ def test_dropped_gestures_are_reported_and_never_run(g1):
     assert [e.name for e in rig.events("started")] == ["chop_right"]
 
 
-def test_the_event_log_stays_bounded_and_cursors_still_work(g1):
-    sequencer = Sequencer(TrajectoryBuilder(g1.limits), g1.neutral_entry.q[0], keep_events=5)
-    cursor = sequencer.events.total
-    for k in range(12):
-        sequencer.drop(GestureCommand(f"g{k}", np.zeros((1, 14)), 1.0), "test", float(k))
-    assert len(sequencer.events) == 5 and sequencer.events.total == cursor + 12
-    assert [e.name for e in sequencer.events.since(cursor + 9)] == ["g9", "g10", "g11"]
-    assert [e.name for e in sequencer.events.since(cursor)] == [f"g{k}" for k in range(7, 12)]
-
-
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(picks=st.lists(st.tuples(st.sampled_from(NAMES), st.integers(1, 5), st.floats(0.0, 6.0)), min_size=1,
                       max_size=4),
