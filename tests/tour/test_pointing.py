@@ -131,7 +131,9 @@ def test_a_colliding_aim_is_retried_with_the_arm_further_out(library):
 
 
 def test_pointing_eval_measures_the_simulated_hand_within_five_degrees(tmp_path):
-    cfg = compose_config(["+experiment=pointing_eval", *synthetic_library(tmp_path / "lib"),
+    # The aiming, with the arm law's gravity feed-forward: under the plain G1 law (tau = 0) the hand hangs
+    # below its target (up to ~11 degrees on the lab tour), which is the law's error, not the aim's.
+    cfg = compose_config(["+experiment=pointing_eval", "arm_law=robot_gravity", *synthetic_library(tmp_path / "lib"),
                           "job.gesture=pointing_a", "job.probe_azimuth_deg=[-60,60]",
                           "job.probe_elevation_deg=[-20,20]", "job.settle_s=0.8"])
     results = run(cfg, tmp_path)

@@ -97,6 +97,6 @@ class G1Settings:
             command_waist=bool(kw["command_waist"]),
             waist_kp=_positive("waist_kp", kw["waist_kp"], allow_zero=True),
             waist_kd=_positive("waist_kd", kw["waist_kd"], allow_zero=True),
-            velocity_feedforward=bool(kw["velocity_feedforward"]),
-            gravity_compensation=bool(kw["gravity_compensation"]),
+            velocity_feedforward=bool(kw.get("velocity_feedforward", False)),
+            gravity_compensation=bool(kw.get("gravity_compensation", False)),
         )
