@@ -5,18 +5,26 @@ the dialogue history and the recording: a pipeline hook writes every value a sta
 MCAP channel (`/plan`, `/resolved`, ...) as `Turn.field_json` serialises it, the moment it exists.
 A scripted Plan (a suite item, a button in the web UI, a robot check) enters at the first stage that
 reads a plan, with no planner call and no JSON round trip.
+A streaming planner's reply (run_streamed) is performed sentence by sentence while the model writes:
+each sentence is a Turn of its own, recorded like any other (emopose/stream_pipelines.py).
 """
 
 from __future__ import annotations
 
-from contextlib import nullcontext
+import threading
+from collections.abc import Callable
+from contextlib import ExitStack, nullcontext
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import Any
 
 from emopose.contract import Plan
 from emopose.pipeline import Pipeline, PipelineError, Stage
 from emopose.planners.base import Planner, PlanRequest
+from emopose.planners.llm_errors import LLMCallError
+from emopose.planners.streaming import SentencePlans, StreamingPlanner
 from emopose.session import Session
+from emopose.stream_pipelines import StreamPipelines
 from emopose.sync_record import TIMELINE, speech_timeline
 from emopose.thinking import ThinkingGesture
 from emopose.turn import ResolvedGesture, Turn
@@ -32,6 +40,8 @@ class TurnRunner:
 
     def __post_init__(self) -> None:
         self._recorded = self.pipeline.with_hooks(self._recording_hook)
+        self._stream: SentencePlans | None = None  # the reply streaming now, for cancel()
+        self._stream_lock = threading.Lock()
 
     def with_pipeline(self, pipeline: Pipeline) -> TurnRunner:
         """The same runner (session, planner, history) running other stages: a suite's variant."""
@@ -53,6 +63,83 @@ class TurnRunner:
             self.history.extend([{"role": "user", "content": utterance},
                                  {"role": "assistant", "content": turn.plan.reply}])
         return turn
+
+    @property
+    def streams(self) -> bool:
+        """True when the configured planner speaks its replies sentence by sentence (run_streamed)."""
+        return isinstance(self.planner, StreamingPlanner) and self.planner.streams
+
+    def respond(self, utterance: str, image: str | bytes | None = None,
+                on_turn: Callable[[Turn], None] | None = None) -> StreamedReply:
+        """One reply to a person: sentence by sentence when the planner streams, else one turn."""
+        if self.streams:
+            return self.run_streamed(utterance, image, on_turn)
+        turn = self.run(utterance, image)
+        if on_turn is not None:
+            on_turn(turn)
+        return StreamedReply([turn])
+
+    def run_streamed(self, utterance: str, image: str | bytes | None = None,
+                     on_turn: Callable[[Turn], None] | None = None) -> StreamedReply:
+        """Speak the streaming planner's reply sentence by sentence as it arrives; each sentence is a Turn
+        (`on_turn` hears each once handed over). The reply joins the history as far as it was spoken."""
+        if not self.streams:
+            raise ValueError(f"planner {self.planner.name} does not stream; use planner=annotate planner.stream=true")
+        self.session.open()
+        request = PlanRequest(utterance=utterance, history=tuple(self.history), image=image)
+        plans = self.planner.stream(request)
+        with self._stream_lock:
+            self._stream, reply = plans, StreamedReply([])
+        try:
+            self._perform(request, plans, reply, on_turn or (lambda turn: None))
+        except LLMCallError as exc:  # after the first sentence: stop here, what was said stays said
+            reply.error = f"the reply stopped after {len(reply.turns)} sentence(s): {exc}"
+        finally:
+            with self._stream_lock:
+                reply.cancelled, self._stream = plans is not self._stream, None
+            plans.cancel()  # closes the HTTP stream whatever ended the loop
+        if reply.turns and not reply.cancelled and self._streamed.dispatch is not None:
+            self._streamed.dispatch.wait()
+        self.history.extend([{"role": "user", "content": utterance}, {"role": "assistant", "content": reply.text}])
+        return reply
+
+    def cancel(self) -> None:
+        """Stop the reply streaming now (an interrupt): no further sentence is performed. Any thread."""
+        with self._stream_lock:
+            plans, self._stream = self._stream, None
+        if plans is not None:
+            plans.cancel()
+
+    def _perform(self, request: PlanRequest, plans: SentencePlans, reply: StreamedReply,
+                 on_turn: Callable[[Turn], None]) -> None:
+        with ExitStack() as thinking:
+            if self.thinking is not None:
+                thinking.enter_context(self.thinking.around_planning())
+            for output in plans:
+                thinking.close()  # the first sentence is here: planning is over
+                if self._stream is not plans:
+                    return  # cancelled while this sentence was being planned
+                turn = Turn(request, planner_output=output)
+                turn.stage_s["planner"] = output.latency_s
+                self._record(turn, "request")
+                self._record(turn, "planner_output")
+                (self._streamed.rest if reply.turns else self._streamed.first).run(turn)
+                if self._stream is not plans:  # the interrupt came while this sentence was handed over
+                    self._silence()
+                    return
+                reply.turns.append(turn)
+                on_turn(turn)
+
+    def _silence(self) -> None:
+        """Undo a sentence handed over after the interrupt that should have cleared it."""
+        dispatch = self._streamed.dispatch
+        if dispatch is not None:
+            dispatch.loop.sequencer.interrupt([], now=dispatch.loop.clock.now())
+            dispatch.player.stop()
+
+    @cached_property
+    def _streamed(self) -> StreamPipelines:
+        return StreamPipelines.derive(self._recorded, self.planner.stream_preroll_s)
 
     def run_plan(self, plan: Plan, utterance: str | None = None,
                  resolved: list[ResolvedGesture] | None = None) -> Turn:
@@ -90,3 +177,18 @@ class TurnRunner:
             return  # serialising a turn costs more than the stage that made it
         value: Any = turn.field_json(name)
         self.session.write(f"/{name}", value if isinstance(value, dict) else {name: value})
+
+
+@dataclass
+class StreamedReply:
+    """A streamed reply: one Turn per sentence performed, whether an interrupt cancelled it, and the error
+    that stopped it early (None when the model finished)."""
+
+    turns: list[Turn]
+    cancelled: bool = False
+    error: str | None = None
+
+    @property
+    def text(self) -> str:
+        """What was said."""
+        return " ".join(t.plan.reply for t in self.turns if t.plan is not None and t.plan.reply)

@@ -155,6 +155,17 @@ class LLMClient:
                 continue
             return self._finish(key, response, attempt + 1, started)
 
+    def open_stream(self, messages: list[dict]) -> tuple[object, int]:
+        """litellm's stream of one chat request (stream=True) and the attempts it took: opened with the
+        same retries as complete(), never cached (a streamed answer is spoken as it arrives)."""
+        self.counters.add(calls=1)
+        kwargs, started = self.call_kwargs(messages, stream=True), time.perf_counter()
+        for attempt in itertools.count():
+            try:
+                return _litellm().completion(**kwargs), attempt + 1
+            except Exception as exc:  # noqa: BLE001 - as in complete()
+                time.sleep(self._retry_delay(exc, attempt, started))
+
     async def acomplete(self, messages: list[dict], pass_index: int = 0, gate: asyncio.Semaphore | None = None,
                         response_format: dict | None = None) -> Completion:  # type: ignore[return]
         """As complete(); `gate` bounds requests on the wire (a call in backoff frees its slot). Waiting

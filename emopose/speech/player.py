@@ -8,7 +8,9 @@ never raises: gestures are released against the returned start, so a device that
 The null sink "plays" for clip.duration_s from the returned start. Under a FakeClock (offline
 rendering, evaluations) the null sink is used whatever the sink setting: a real device cannot follow
 virtual time. The returned start is launch time + latency_s (device output latency, measured per
-device; sounddevice reports its own).
+device; sounddevice reports its own). play(..., follow=True) queues a streamed reply's next sentence:
+it starts when the clip playing ends (the device is launched one latency earlier), or at once if
+nothing plays; stop() also cancels a clip waiting to follow.
 """
 
 from __future__ import annotations
@@ -35,16 +37,21 @@ class Player:
         self._device: list[str] | object | None | bool = None  # None: not probed yet; False: none/failed
         self._process: subprocess.Popen | None = None
         self._lock = threading.Lock()
+        self._generation = 0  # bumped by stop(): a clip scheduled to follow checks it before it starts
         self.started_at: float | None = None
         self.ends_at: float | None = None
         self.last_sink = "none"
 
     # -- public --------------------------------------------------------------------------------
-    def play(self, clip: SpeechClip, clock: Clock) -> float:
-        self.stop()  # a new reply cuts the old one off, as the sequencer's interrupt does for gestures
-        start = self._start_device(clip, clock)
-        if start is None:
-            self.last_sink, start = "none", clock.now()
+    def play(self, clip: SpeechClip, clock: Clock, follow: bool = False) -> float:
+        """`follow` (a streamed reply's next sentence): start when the clip playing ends, not now."""
+        if follow and self.playing(clock):
+            start = self._follow(clip, clock, self.ends_at)
+        else:
+            self.stop()  # a new reply cuts the old one off, as the sequencer's interrupt does for gestures
+            start = self._start_device(clip, clock)
+            if start is None:
+                self.last_sink, start = "none", clock.now()
         self.started_at, self.ends_at = start, start + clip.duration_s
         return start
 
@@ -60,6 +67,8 @@ class Player:
     def stop(self) -> None:
         with self._lock:
             process, self._process = self._process, None
+            self._generation += 1  # clips waiting to follow are not started
+        self.ends_at = None
         if process is not None and process.poll() is None:
             process.stopped_by_us = True
             process.terminate()
@@ -69,6 +78,23 @@ class Player:
     # -- device --------------------------------------------------------------------------------
     def _silent(self, clip: SpeechClip, clock: Clock) -> bool:
         return self.sink == "none" or isinstance(clock, FakeClock) or clip.audio_path is None or clip.duration_s <= 0
+
+    def _follow(self, clip: SpeechClip, clock: Clock, at: float) -> float:
+        """Start the clip at `at` (heard then: launched one device latency earlier), unless stop() comes first."""
+        if self._silent(clip, clock) or not self._probe():
+            return at  # the null sink just plays on
+        with self._lock:
+            generation = self._generation
+
+        def launch() -> None:
+            clock.sleep_until(at - self.latency_s)
+            with self._lock:
+                current = generation == self._generation
+            if current:
+                self._start_device(clip, clock)
+
+        threading.Thread(target=launch, daemon=True, name="emopose-audio-next").start()
+        return at
 
     def _start_device(self, clip: SpeechClip, clock: Clock) -> float | None:
         if self._silent(clip, clock):

@@ -31,6 +31,7 @@ class Dispatch:
     player: Player = field(repr=False)
     timeout_s: float = 60.0
     until: str = "rest"
+    follow: bool = False  # a streamed reply's sentences: the audio follows the clip playing (no cut)
     name = "dispatch"
     reads = ("speech", "submitted")
     writes = ("dispatched",)
@@ -45,16 +46,20 @@ class Dispatch:
         clock, play_at = self.loop.clock, turn.submitted.play_at
         if clock.now() < play_at:  # the timeline's pre-roll: the first gesture prepares before the words
             self.loop.wait_until(lambda: clock.now() >= play_at - 1e-9, play_at - clock.now() + 1.0)
-        speech_start = self.player.play(turn.speech, self.loop.clock)
+        speech_start = (self.player.play(turn.speech, clock, follow=True) if self.follow
+                        else self.player.play(turn.speech, clock))
         late = speech_start - turn.submitted.speech_start
         if late:
             sequencer.retime({c.id for c in turn.submitted.commands}, late)
-        if self.until == "none":
-            done = True
-        elif self.until == "settle":
-            done = self.loop.wait_until(sequencer.settled, self.timeout_s)
-        else:
-            done = self.loop.wait_until(lambda: sequencer.settled() and sequencer.state == State.IDLE,
-                                        self.timeout_s)
+        done = self.wait()
         return DispatchReport(done, tuple(sequencer.events.since(first_event)), self.loop.stats.ticks - ticks,
                               speech_start)
+
+    def wait(self) -> bool:
+        """Wait as `until` says (a streamed reply waits once, after its last sentence); False on timeout."""
+        sequencer = self.loop.sequencer
+        if self.until == "none":
+            return True
+        if self.until == "settle":
+            return self.loop.wait_until(sequencer.settled, self.timeout_s)
+        return self.loop.wait_until(lambda: sequencer.settled() and sequencer.state == State.IDLE, self.timeout_s)

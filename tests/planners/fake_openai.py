@@ -5,7 +5,9 @@ hosted provider (api_base = server.url), so nothing inside litellm is mocked. An
 FIFO script first, then from `default` (an Answer, or a callable (body, index) -> Answer). Every
 request body is recorded for assertions, and two counters stand in for wall-clock bounds: `peak`
 (the most requests in progress at once: concurrency) and `answered` (answers sent so far; one still
-sitting out its delay is not, so a client that returned before it has timed out).
+sitting out its delay is not, so a client that returned before it has timed out). A request with
+"stream": true gets server-sent events (fake_stream.py: paced tokens, a held or dying stream);
+`tokens_sent` and `streams_dropped` (streams the client closed early) count them.
 
     with FakeOpenAI() as server:
         server.script(http_error(500), ok(PLAN_JSON))
@@ -28,6 +30,7 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Self
 
 from fake_answers import FAULTS, PLAN_JSON, Answer, faulty, http_error, ok
+from fake_stream import generation_s, send_stream, streamed
 
 __all__ = ["PLAN_JSON", "Answer", "FakeOpenAI"]
 
@@ -79,6 +82,7 @@ class FakeOpenAI:
         self.paths: list[str] = []
         self.served: Counter[str] = Counter()  # answer kinds sent, e.g. {"ok": 9, "http_500": 1}
         self.in_progress = self.peak = self.answered = 0
+        self.tokens_sent = self.streams_dropped = 0  # streaming: tokens written; streams the client closed early
         self._script: deque[Answer] = deque()
         self._lock = threading.Lock()
         self._stopping = threading.Event()
@@ -185,10 +189,13 @@ class FakeOpenAI:
                     self._send(400, {"error": {"message": "request body is not JSON"}})
                     return
                 answer = server._next_answer(body, self.path, self.headers.get("Authorization"))
-                if answer.delay_s and server._stopping.wait(answer.delay_s):
+                delay_s = answer.delay_s + (0.0 if body.get("stream") else generation_s(answer))
+                if delay_s and server._stopping.wait(delay_s):
                     sent = False  # the server is shutting down
                 elif answer.status != 200:
                     sent = self._send(answer.status, _error_body(answer.status, answer.message), answer.headers)
+                elif body.get("stream"):
+                    sent = send_stream(self, answer, body.get("model", ""), server)
                 else:
                     sent = self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
                 server._done(sent)
@@ -222,8 +229,12 @@ def main() -> None:
     parser.add_argument("--api-key", default=None)
     parser.add_argument("--models", nargs="*", default=None)
     parser.add_argument("--context-window", type=int, default=None)
+    parser.add_argument("--reply", default=None, help="answer with this text ({n}: the request's number), paced")
+    parser.add_argument("--first-token-s", type=float, default=0.0)
+    parser.add_argument("--tokens-per-s", type=float, default=0.0)
     args = parser.parse_args()
-    default = faulty(args.delay, args.bad_rate, args.seed, tuple(args.mix), args.slow)
+    default = (faulty(args.delay, args.bad_rate, args.seed, tuple(args.mix), args.slow) if args.reply is None
+               else lambda body, n: streamed(args.reply.replace("{n}", str(n)), args.first_token_s, args.tokens_per_s))
     with FakeOpenAI(default, args.api_key, args.models and tuple(args.models), args.context_window) as server:
         print(json.dumps({"url": server.url}), flush=True)
         sys.stdin.read()
