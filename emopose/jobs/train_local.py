@@ -1,9 +1,11 @@
-"""+experiment=train_local: (re)train the local planner and score it on the held-out training slice.
+"""+experiment=train_local: train the local planner and score it on the held-out training slice.
 
-Building the run trains the planner if no cached artifact matches the training files and
-hyper-parameters (delete the cache file, or change planner.training.seed, to force a retrain). The
-held-out slice is every training item (single- and multi-act) whose id hashes into
-planner.training.holdout_percent; those never enter training. The benchmark suites are not touched:
+Training is planners/local_artifact.train_artifact, which the planner's first use calls too: building
+the run trains when no cached artifact matches the training files and hyper-parameters, and
+`job.retrain=true` trains again even when one does (progress bars with ETA on stderr). The held-out
+slice is every training item (single-act, multi-act and dialogue) whose id hashes into
+planner.training.holdout_percent; those never enter training. Dialogues are scored with and without
+their history (history must never hurt). The benchmark suites are not touched:
 this is where the split parameters (temperature, boundary_weight, act_cost) are chosen, with
 `job.search` listing values to try (every combination is scored from one forward pass per item).
 """
@@ -15,12 +17,24 @@ from dataclasses import dataclass
 
 from emopose.bench.sequence_metrics import SequencePrediction, item_scores
 from emopose.bench.suites import SequenceItem
-from emopose.resources import Run
 from emopose.jobs.report import markdown_table, write_results
 from emopose.planners.local import LocalPlanner, ScoredUtterance, trigger_span
+from emopose.planners.local_config import TrainingConfig
+from emopose.planners.local_context import LocalContextPlanner
 from emopose.planners.local_data import Example, load_examples
+from emopose.resources import Run
 
 SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
+
+
+def context_metrics(planner: LocalPlanner, dialogues: list[Example]) -> dict:
+    """Top-1 of the dialogue items read with and without their history (fractions)."""
+    def top1(with_history: bool) -> float:
+        first = [planner.best_split(planner.score(e.text, e.history if with_history else ()))[0]
+                 for e in dialogues]
+        return sum(a.cls == e.acts[0].label for a, e in zip(first, dialogues)) / max(1, len(dialogues))
+
+    return {"context_with_history": top1(True), "context_without": top1(False), "dialogues": len(dialogues)}
 
 
 def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: list[ScoredUtterance]) -> dict:
@@ -56,6 +70,7 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
 @dataclass
 class TrainLocalJob:
     search: dict[str, list[float]] | None = None  # split parameter -> values to try
+    retrain: bool = False  # train even when a cached artifact matches
 
     def __post_init__(self) -> None:
         """Check job.search when the job is built, before the run (and any training) is."""
@@ -73,8 +88,14 @@ class TrainLocalJob:
         res = run.resources
         planner = res.planner
         if not isinstance(planner, LocalPlanner):
-            raise ValueError("train_local needs planner=local")
-        examples = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
+            raise ValueError("train_local needs planner=local or planner=local_context")
+        if self.retrain:
+            if not isinstance(planner, LocalContextPlanner):
+                raise ValueError("job.retrain needs planner=local_context "
+                                 "(for planner=local, delete its cache file)")
+            planner.retrain()
+        held_out = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
+        examples = [e for e in held_out if not e.history]
         scored = [planner.score(e.text) for e in examples]
         configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
         search = self.search or {}
@@ -84,18 +105,22 @@ class TrainLocalJob:
             for setting in grid or [{}]:
                 for name, value in {**configured, **setting}.items():
                     setattr(planner, name, value)
-                rows.append({**configured, **setting, **held_out_metrics(planner, examples, scored)})
+                rows.append({**configured, **setting, **held_out_metrics(planner, examples, scored),
+                             **context_metrics(planner, [e for e in held_out if e.history])})
         finally:
             for name, value in configured.items():
                 setattr(planner, name, value)
-        header = [*SPLIT_PARAMETERS, "single top-1", "kept whole", "sequence exact", "anchor recall", "exact variant"]
-        table = markdown_table(header, [[*(r[p] for p in SPLIT_PARAMETERS), *(f"{100 * r[k]:.1f}%" for k in
-                                         ("single_top1", "single_kept_whole", "sequence_exact", "anchor_recall",
-                                          "exact_variant"))]
-                                        for r in rows])
+        header = [*SPLIT_PARAMETERS, "single top-1", "kept whole", "sequence exact", "anchor recall",
+                  "exact variant", "dialogue, with history", "without"]
+        metrics = ("single_top1", "single_kept_whole", "sequence_exact", "anchor_recall", "exact_variant",
+                   "context_with_history", "context_without")
+        table = markdown_table(header, [[*(r[p] for p in SPLIT_PARAMETERS),
+                                         *(f"{100 * r[k]:.1f}%" for k in metrics)] for r in rows])
         text = (f"Local planner on the held-out training slice ({rows[0]['singles']} single-act, "
-                f"{rows[0]['sequences']} multi-act items)\n\n{table}")
-        results = {"held_out": rows, "training": vars(planner.model.config)}
+                f"{rows[0]['sequences']} multi-act, {rows[0]['dialogues']} dialogue items)\n\n{table}")
+        config = planner.model.config
+        results = {"held_out": rows,
+                   "training": config.model_dump() if isinstance(config, TrainingConfig) else vars(config)}
         write_results(res.run_dir, results, text)
         print(text)
         return results

@@ -96,12 +96,16 @@ class LocalPlanner:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         self.library = library
         self.train_files = list(train_files)
-        self.model = load_or_train(list(train_files), cache_dir, TrainingConfig(**(training or {})), bf16_inference,
-                                   trace_inference, self._catalogue())
+        self.model = self._build_model(cache_dir, training or {}, bf16_inference, trace_inference)
         self.min_words, self.max_records = min_words, max_records
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
         self.context_weight = context_weight
         self._variant_vectors: tuple[int, dict[str, tuple[list[str], np.ndarray]]] = (-1, {})
+
+    def _build_model(self, cache_dir: str, training: dict, bf16_inference: bool, trace_inference: bool):
+        """The trained model (trained first if no cached one matches); planners/local_context.py swaps it."""
+        return load_or_train(self.train_files, cache_dir, TrainingConfig(**training), bf16_inference,
+                             trace_inference, self._catalogue())
 
     def plan(self, request: PlanRequest) -> PlannerOutput:
         with timed() as clock:
@@ -167,7 +171,7 @@ class LocalPlanner:
         version, by_class = self._variant_vectors
         if version != self.library.version:
             catalogue = self._catalogue()
-            matrix = self.model.embed([text for _, text in catalogue.values()])
+            matrix = self._describe([text for _, text in catalogue.values()])
             names = list(catalogue)
             by_class = {c: ([n for n in names if catalogue[n][0] == c],
                             matrix[[i for i, n in enumerate(names) if catalogue[n][0] == c]]) for c in CLASSES}
@@ -176,3 +180,7 @@ class LocalPlanner:
         if not names:
             return None
         return names[int(np.argmax(matrix @ self.model.project(vector[None])[0]))]
+
+    def _describe(self, texts: list[str]) -> np.ndarray:
+        """Description vectors in the space variant() compares projected act vectors in."""
+        return self.model.embed(texts)

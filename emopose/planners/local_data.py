@@ -9,7 +9,10 @@ the planner can choose at run time:
   joins the act before it (or the first act, at the start);
 - synthetic sequences join 2-4 single-act training items of different classes with varied joiners
   ("; ", ", but ", ". ", ...), so the boundary model sees many more act changes than the hand-written
-  sequences alone hold.
+  sequences alone hold;
+- a dialogue item (train/context/) is one act over its final utterance, read after its history;
+- distractors give single-act items the history of an unrelated dialogue, label unchanged, so the
+  model learns that a history which does not bear on the utterance must not sway it.
 
 Items whose id hashes into the held-out bucket never enter training (the quality check scores them).
 """
@@ -41,6 +44,7 @@ class Example:
     pieces: list[Segment]
     anchors: list[tuple[int, int]] = field(default_factory=list)  # empty: no anchor supervision
     variants: list[str] = field(default_factory=list)  # annotated motion per act; empty: none
+    history: tuple[dict, ...] = ()  # dialogue turns before the text (spans are in the text alone)
 
     @property
     def boundaries(self) -> list[int]:
@@ -63,9 +67,9 @@ def is_held_out(item_id: str, percent: int) -> bool:
     return int(hashlib.sha256(item_id.encode()).hexdigest(), 16) % 100 < percent
 
 
-def single_act(item_id: str, text: str, label: str) -> Example:
+def single_act(item_id: str, text: str, label: str, history: tuple[dict, ...] = ()) -> Example:
     pieces = segments(text) or [Segment(text, 0, len(text), True)]
-    return Example(item_id, text, [Act(pieces[0].start, pieces[-1].end, label)], pieces)
+    return Example(item_id, text, [Act(pieces[0].start, pieces[-1].end, label)], pieces, history=history)
 
 
 def multi_act(row: dict) -> Example | None:
@@ -150,9 +154,20 @@ def synthetic_sequences(singles: list[Example], count: int, seed: int) -> list[E
     return out
 
 
+def context_distractors(singles: list[Example], dialogues: list[Example], count: int,
+                        seed: int) -> list[Example]:
+    """`count` single-act items, each after the history of a randomly drawn dialogue."""
+    rng = random.Random(seed)
+    if not singles or not dialogues:
+        return []
+    return [single_act(f"distractor-{n}", item.text, item.acts[0].label, rng.choice(dialogues).history)
+            for n, item in enumerate(rng.choices(singles, k=count))]
+
+
 def load_examples(paths: list[str], holdout_percent: int, held_out: bool = False,
-                  synthetic: int = 0, seed: int = 0) -> list[Example]:
-    """Training examples (held_out=False, plus `synthetic` joined sequences) or the held-out slice."""
+                  synthetic: int = 0, distractors: int = 0, seed: int = 0) -> list[Example]:
+    """Training examples (held_out=False, plus `synthetic` joined sequences and `distractors` items
+    after unrelated dialogues) or the held-out slice."""
     examples: list[Example] = []
     for path in paths:
         for line in Path(path).read_text().splitlines():
@@ -161,12 +176,17 @@ def load_examples(paths: list[str], holdout_percent: int, held_out: bool = False
             row = json.loads(line)
             if is_held_out(row["id"], holdout_percent) != held_out:
                 continue
-            example = single_act(row["id"], row["text"], row["label"]) if "label" in row else multi_act(row)
+            if "label" in row:
+                example = single_act(row["id"], row["text"], row["label"], tuple(row.get("history", ())))
+            else:
+                example = multi_act(row)
             if example is not None:
                 examples.append(example)
     bad = {a.label for e in examples for a in e.acts} - set(CLASSES)
     if bad:
         raise ValueError(f"training labels {sorted(bad)} are not among {CLASSES}")
-    if synthetic and not held_out:
-        examples += synthetic_sequences([e for e in examples if len(e.acts) == 1], synthetic, seed)
+    if not held_out:
+        singles = [e for e in examples if len(e.acts) == 1 and not e.history]
+        examples += synthetic_sequences(singles, synthetic, seed) if synthetic else []
+        examples += context_distractors(singles, [e for e in examples if e.history], distractors, seed)
     return examples

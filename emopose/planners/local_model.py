@@ -38,7 +38,6 @@ import numpy as np
 from emopose import CLASSES
 from emopose.planners.local_data import Example, load_examples
 from emopose.planners.segment import Segment
-from emopose.planners.semi_crf import log_partition, split_score
 
 log = logging.getLogger(__name__)
 ARTIFACT_VERSION = 6
@@ -113,6 +112,41 @@ def boundary_features(class_states, piece_ranges: list[tuple[int, int]]):
     return torch.cat([left, right, left * right, (left - right).abs()], dim=1)
 
 
+def new_heads(width: int) -> tuple:
+    """(act head, boundary head, anchor head, variant projection), freshly initialised (seed first)."""
+    import torch
+
+    act = torch.nn.Linear(width, len(CLASSES))  # created in this order: the seeded initialisation depends on it
+    boundary = torch.nn.Sequential(torch.nn.Linear(4 * width, 64), torch.nn.ReLU(), torch.nn.Linear(64, 1))
+    anchor = torch.nn.Linear(width, 1)
+    projection = torch.nn.Linear(width, width, bias=False)
+    torch.nn.init.eye_(projection.weight)
+    return act, boundary, anchor, projection
+
+
+def span_scores(act_head, logit_scale: float, analysis: Analysis,
+                spans: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """(class logits (S, 8), semantic vectors (S, D)) of character spans of the text. The logits are
+    unnormalised: the split model compares them across spans, softmax gives class probabilities."""
+    import torch
+
+    ranges = [analysis.token_range(a, b) for a, b in spans]
+    with torch.inference_mode():
+        logits = act_head(pooled(analysis.class_states, ranges)) * logit_scale
+        return logits.numpy(), pooled(analysis.semantic_states, ranges).numpy()
+
+
+def boundary_scores(boundary_head, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
+    """Logit that a new act starts before pieces[k], for k = 1 .. len(pieces) - 1."""
+    import torch
+
+    if len(pieces) < 2:
+        return np.zeros(0)
+    ranges = [analysis.token_range(p.start, p.end) for p in pieces]
+    with torch.inference_mode():
+        return boundary_head(boundary_features(analysis.class_states, ranges)).squeeze(-1).numpy()
+
+
 class ActModel:
     """MiniLM + act / boundary / anchor heads and the variant projection. Thread-safe inference."""
 
@@ -127,12 +161,7 @@ class ActModel:
         self.body = AutoModel.from_pretrained(str(get_model_path()))
         width = self.body.config.hidden_size
         torch.manual_seed(config.seed)
-        self.act_head = torch.nn.Linear(width, len(CLASSES))
-        self.boundary_head = torch.nn.Sequential(torch.nn.Linear(4 * width, 64), torch.nn.ReLU(),
-                                                 torch.nn.Linear(64, 1))
-        self.anchor_head = torch.nn.Linear(width, 1)
-        self.variant_projection = torch.nn.Linear(width, width, bias=False)
-        torch.nn.init.eye_(self.variant_projection.weight)
+        self.act_head, self.boundary_head, self.anchor_head, self.variant_projection = new_heads(width)
         self._catalogue: tuple[dict[str, list[str]], dict[str, object]] = ({}, {})
         self.bf16_inference = bf16_inference and torch.ops.mkldnn._is_mkldnn_bf16_supported()
         self.trace_inference = trace_inference
@@ -159,55 +188,12 @@ class ActModel:
         return out.last_hidden_state, out.hidden_states[-1 - self.config.trainable_layers]
 
     def _inference_encoder(self):
-        """A copy of the encoder for inference: bfloat16 where the CPU has native support, traced and
-        frozen with TorchScript when asked (a traced graph skips most of eager PyTorch's per-operator
-        overhead, which dominates at utterance length). The traced copy is checked against eager on a
-        probe batch and dropped, with a warning, if they disagree."""
-        import copy
-        import warnings
+        """A copy of the encoder for inference, bfloat16 and traced as set (planners/local_inference.py)."""
+        from emopose.planners.local_inference import EXAMPLE_TEXTS, PROBE_TEXT, inference_encoder
 
-        import torch
-
-        body = copy.deepcopy(self.body).eval()
-        dtype = torch.bfloat16 if self.bf16_inference else torch.float32
-        body.to(dtype)
-
-        def eager(inputs: dict) -> tuple:
-            return self._encode(body, inputs)
-
-        if not self.trace_inference:
-            return eager
-        inputs, _, _ = self._tokens(["A probe sentence, with a comma and more words.", "Short one."])
-        encode = self._encode
-
-        class Wrapped(torch.nn.Module):
-            def __init__(self) -> None:
-                super().__init__()
-                self.body = body
-
-            def forward(self, input_ids, token_type_ids, attention_mask):
-                return encode(self.body, {"input_ids": input_ids, "token_type_ids": token_type_ids,
-                                          "attention_mask": attention_mask})
-
-        names = ("input_ids", "token_type_ids", "attention_mask")
-        probe, _, _ = self._tokens(["Over there, next to the tall green cabinet!"])
-        try:
-            with torch.no_grad(), warnings.catch_warnings():
-                warnings.simplefilter("ignore", torch.jit.TracerWarning)  # shape checks that hold for any length
-                # torch.jit is deprecated for torch.compile, which needs a toolchain and minutes at load;
-                # the pinned torch still ships it, and a release without it falls back to eager below.
-                warnings.simplefilter("ignore", DeprecationWarning)
-                traced = torch.jit.freeze(torch.jit.trace(Wrapped().eval(), tuple(inputs[n] for n in names),
-                                                          strict=False))
-                expected, got = eager(probe), traced(*(probe[n] for n in names))
-        except (AttributeError, RuntimeError) as exc:
-            log.warning("cannot trace the encoder (%s); using eager inference", exc)
-            return eager
-        tolerance = 0.1 if dtype == torch.bfloat16 else 1e-3
-        if any((a.float() - b.float()).abs().max() > tolerance for a, b in zip(expected, got)):
-            log.warning("traced encoder disagrees with eager PyTorch; using eager inference")
-            return eager
-        return lambda inputs: traced(*(inputs[n] for n in names))
+        return inference_encoder([self.body], lambda parts, inputs: self._encode(parts[0], inputs),
+                                 self._tokens(EXAMPLE_TEXTS)[0], self._tokens([PROBE_TEXT])[0],
+                                 self.bf16_inference, self.trace_inference)
 
     def prepare_inference(self) -> None:
         """Build the inference encoder now (load time) rather than inside the first plan's latency."""
@@ -232,24 +218,10 @@ class ActModel:
         return out
 
     def classify_spans(self, analysis: Analysis, spans: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
-        """(class logits (S, 8), semantic vectors (S, D)) of character spans of the text. The logits are
-        unnormalised: the split model compares them across spans, softmax gives class probabilities."""
-        import torch
-
-        ranges = [analysis.token_range(a, b) for a, b in spans]
-        with torch.inference_mode():
-            logits = self.act_head(pooled(analysis.class_states, ranges)) * self.config.logit_scale
-            return logits.numpy(), pooled(analysis.semantic_states, ranges).numpy()
+        return span_scores(self.act_head, self.config.logit_scale, analysis, spans)
 
     def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
-        """Logit that a new act starts before pieces[k], for k = 1 .. len(pieces) - 1."""
-        import torch
-
-        if len(pieces) < 2:
-            return np.zeros(0)
-        ranges = [analysis.token_range(p.start, p.end) for p in pieces]
-        with torch.inference_mode():
-            return self.boundary_head(boundary_features(analysis.class_states, ranges)).squeeze(-1).numpy()
+        return boundary_scores(self.boundary_head, analysis, pieces)
 
     def project(self, semantic: np.ndarray) -> np.ndarray:
         """Act semantic vectors -> the description space the variant choice compares in, normalised."""
@@ -355,12 +327,9 @@ class ActModel:
 
     def _split_nll(self, example: Example, gold: list[tuple[tuple[int, int], str]], analysis: Analysis, openings):
         """-log P(gold split | utterance) under the semi-CRF over every split of its segments."""
-        pieces, n = example.pieces, len(example.pieces)
-        spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)]
-        ranges = [analysis.token_range(pieces[i].start, pieces[j - 1].end) for i, j in spans]
-        span_scores = self.act_head(pooled(analysis.class_states, ranges)) * self.config.logit_scale
-        acts = [(spans.index(span), CLASSES.index(label)) for span, label in gold]
-        return log_partition(n, spans, span_scores, openings) - split_score(acts, spans, span_scores, openings)
+        from emopose.planners.local_training import split_nll
+
+        return split_nll(self, example, gold, analysis, openings)
 
     def state(self) -> dict:
         n = len(self.body.encoder.layer)

@@ -1,0 +1,128 @@
+"""Inference with a trained local planner model (planners/local_model.py): thread-safe, fast encoder.
+
+The encoder used here is a copy made once at load: bfloat16 where the CPU has native support, traced
+and frozen with TorchScript when asked (a traced graph skips most of eager PyTorch's per-operator
+overhead, which dominates at utterance length). The traced copy is checked against eager on a probe
+and dropped, with a warning, if they disagree.
+"""
+
+from __future__ import annotations
+
+import copy
+import logging
+import threading
+import warnings
+from collections.abc import Sequence
+
+import numpy as np
+
+from emopose.planners.local_context_model import ActModel
+from emopose.planners.local_model import Analysis, boundary_scores, pooled, span_scores
+from emopose.planners.segment import Segment
+
+log = logging.getLogger(__name__)
+_NAMES = ("input_ids", "token_type_ids", "attention_mask")
+
+
+def inference_encoder(modules: list, encode, example: dict, probe: dict, bf16: bool, trace: bool):
+    """inputs -> encode(copies of modules, inputs), for inference: the modules are copied, in bfloat16
+    where asked and the CPU supports it, traced when asked (example: inputs to trace with; probe: inputs
+    the traced copy must reproduce eager outputs on). Also planner=local's (planners/local_model.py)."""
+    import torch
+
+    copies = [copy.deepcopy(m).eval() for m in modules]
+    dtype = torch.bfloat16 if bf16 and torch.ops.mkldnn._is_mkldnn_bf16_supported() else torch.float32
+    for module in copies:
+        module.to(dtype)
+
+    def eager(inputs: dict) -> tuple:
+        return encode(copies, inputs)
+
+    if not trace:
+        return eager
+
+    class Wrapped(torch.nn.Module):
+        def __init__(self) -> None:
+            super().__init__()
+            self.parts = torch.nn.ModuleList(copies)
+
+        def forward(self, input_ids, token_type_ids, attention_mask):
+            return encode(list(self.parts), dict(zip(_NAMES, (input_ids, token_type_ids, attention_mask))))
+
+    try:
+        with torch.no_grad(), warnings.catch_warnings():
+            warnings.simplefilter("ignore", torch.jit.TracerWarning)  # shape checks that hold for any length
+            # torch.jit is deprecated for torch.compile, which needs a toolchain and minutes at load;
+            # the pinned torch still ships it, and a release without it falls back to eager below.
+            warnings.simplefilter("ignore", DeprecationWarning)
+            traced = torch.jit.freeze(torch.jit.trace(Wrapped().eval(), tuple(example[n] for n in _NAMES),
+                                                      strict=False))
+            expected, got = eager(probe), traced(*(probe[n] for n in _NAMES))
+    except (AttributeError, RuntimeError) as exc:
+        log.warning("cannot trace the encoder (%s); using eager inference", exc)
+        return eager
+    tolerance = 0.1 if dtype == torch.bfloat16 else 1e-3
+    if any((a.float() - b.float()).abs().max() > tolerance for a, b in zip(expected, got)):
+        log.warning("traced encoder disagrees with eager PyTorch; using eager inference")
+        return eager
+    return lambda inputs: traced(*(inputs[n] for n in _NAMES))
+
+
+EXAMPLE_TEXTS = ["A probe sentence, with a comma and more words.", "Short one."]
+PROBE_TEXT = "Over there, next to the tall green cabinet!"
+
+
+class LocalInference:
+    """A trained ActModel's predictions for the planner: analyse texts, then score spans from the states."""
+
+    def __init__(self, model: ActModel, bf16: bool = False, trace: bool = False) -> None:
+        import torch
+
+        self.model = model
+        asked = [{"role": "assistant", "content": "Where is it?"}]
+        with torch.inference_mode():
+            self._encoder = inference_encoder(
+                [model.body, model.sentence_top], lambda parts, inputs: model.encode(*parts, inputs),
+                model.tokens(EXAMPLE_TEXTS).inputs, model.tokens([PROBE_TEXT], [asked]).inputs, bf16, trace)
+        self._lock = threading.Lock()
+
+    @property
+    def config(self):
+        return self.model.config
+
+    def analyse(self, texts: list[str], histories: Sequence[Sequence[dict]] | None = None) -> list[Analysis]:
+        """Each text read after its dialogue history (histories[k], may be empty)."""
+        import torch
+
+        with self._lock, torch.inference_mode():
+            tokens = self.model.tokens(texts, histories)
+            class_states, semantic = self._encoder(tokens.inputs)
+            out = []
+            for k, idx in enumerate(tokens.real):
+                states = class_states[k, idx].float()
+                anchor = self.model.anchor_head(states).squeeze(-1).numpy()
+                out.append(Analysis(tokens.starts[k], states, semantic[k, idx].float(), anchor))
+        return out
+
+    def classify_spans(self, analysis: Analysis,
+                       spans: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+        return span_scores(self.model.act_head, self.config.logit_scale, analysis, spans)
+
+    def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
+        return boundary_scores(self.model.boundary_head, analysis, pieces)
+
+    def project(self, semantic: np.ndarray) -> np.ndarray:
+        """Semantic vectors (acts or descriptions) -> the space the variant choice compares in, normalised."""
+        import torch
+
+        with torch.inference_mode():
+            vectors = torch.from_numpy(np.ascontiguousarray(semantic, dtype=np.float32))
+            out = self.model.variant_projection(vectors)
+            return torch.nn.functional.normalize(out, dim=-1).numpy()
+
+    def embed(self, texts: list[str]) -> np.ndarray:
+        """Normalised semantic sentence embeddings, (N, D)."""
+        if not texts:
+            return np.zeros((0, self.model.body.config.hidden_size), dtype=np.float32)
+        analyses = self.analyse(texts)
+        return np.stack([pooled(a.semantic_states, [(0, len(a.starts))])[0].numpy() for a in analyses])

@@ -1,0 +1,44 @@
+"""New motions added to the library as files (a description, no training data) are picked, no retraining.
+
+tests/planners/new_motions/ holds five motion files of five classes and five utterances written about
+each; neither the motions nor the utterances appear in the training split.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+from emopose.planners.base import PlanRequest
+from tests.planners.local_helpers import configured_local_planner
+
+NEW = Path(__file__).parent / "new_motions"
+
+
+@pytest.fixture(scope="module", params=["local", "local_context"])
+def planner(request, tmp_path_factory):
+    return configured_local_planner(tmp_path_factory.mktemp("lib") / "g1", f"planner={request.param}")
+
+
+# Target of the planner issue, not reached yet: measured picks out of 5 (sailor_salute, thumbs_up, finger_wag,
+# head_scratch, point_down) are 2/2/1/0/4 with planner=local and 5/3/2/0/3 with planner=local_context (most
+# misses there are class errors: "I'm baffled" read as rejecting). Strict: a pass fails, so the mark goes.
+@pytest.mark.xfail(strict=True, reason="new motions are not yet picked for >= 80 % of their utterances")
+@pytest.mark.slow
+def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
+    rows = [json.loads(line) for line in (NEW / "utterances.jsonl").read_text().splitlines()]
+    folder = planner.library.snapshot.files["shrug"].parent  # the fixture's writable copy
+    for motion_file in NEW.glob("*.yaml"):
+        shutil.copy(motion_file, folder)
+    planner.library.reload()
+    assert {r["motion"] for r in rows} <= set(planner.library.snapshot.entries)
+    picked: Counter = Counter()
+    for row in rows:
+        gestures = json.loads(planner.plan(PlanRequest(row["text"])).raw)["gestures"]
+        picked[row["motion"]] += any(g["variant"] == row["motion"] for g in gestures[:1])
+    per_motion = {m: picked[m] / sum(r["motion"] == m for r in rows) for m in {r["motion"] for r in rows}}
+    assert min(per_motion.values()) >= 0.8, per_motion

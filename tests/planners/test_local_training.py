@@ -1,0 +1,78 @@
+"""Local planner training: dialogue examples, frozen layers run once, progress with ETA."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from emopose.planners.local_config import TrainingConfig
+from emopose.planners.local_context_model import CONTEXT_CHARS, ActModel, context_prefix
+from emopose.planners.local_data import load_examples
+
+DIALOGUE = ({"role": "user", "content": "Can my son touch the starfish?"},
+            {"role": "assistant", "content": "Of course. I could also take him behind the scenes."})
+
+
+def write_jsonl(path, rows: list[dict]) -> str:
+    path.write_text("".join(json.dumps(row) + "\n" for row in rows))
+    return str(path)
+
+
+def test_context_prefix_marks_roles_and_keeps_the_latest_turns():
+    assert context_prefix(()) == ""
+    assert context_prefix(DIALOGUE) == ("visitor: Can my son touch the starfish? "
+                                        "guide: Of course. I could also take him behind the scenes. [SEP] ")
+    turns = tuple({"role": "assistant", "content": f"turn {k} " + "word " * 15} for k in range(5))
+    assert "turn 3" in context_prefix(turns) and "turn 2" not in context_prefix(turns)  # the last two turns
+    long = context_prefix(({"role": "user", "content": "first " + "word " * 100},))
+    assert len(long) <= CONTEXT_CHARS + len(" [SEP] ") and long.startswith("word ")  # the newest words, whole
+
+
+@pytest.fixture(scope="module")
+def model():
+    return ActModel(TrainingConfig(trainable_layers=1, epochs=2, batch_size=4))
+
+
+def test_utterance_tokens_are_read_in_context_but_located_in_the_utterance(model):
+    alone, in_context = (model.tokens(["Him? Back there? Absolutely not."], h) for h in (None, [DIALOGUE]))
+    assert alone.starts == in_context.starts  # character starts relative to the utterance either way
+    assert in_context.inputs["input_ids"].shape[1] > alone.inputs["input_ids"].shape[1]
+    first = in_context.inputs["input_ids"][0, in_context.real[0][0]]
+    assert model.tokenizer.decode(first) == "him"
+
+
+def test_dialogue_items_and_distractors_are_training_examples(tmp_path):
+    singles = write_jsonl(tmp_path / "singles.jsonl", [
+        {"id": f"s{k}", "text": f"Welcome aboard, guest {k}.", "label": "welcoming"} for k in range(6)])
+    dialogues = write_jsonl(tmp_path / "dialogues.jsonl", [
+        {"id": "d1", "history": list(DIALOGUE), "text": "Absolutely not.", "label": "rejecting"}])
+    examples = load_examples([singles, dialogues], 0, distractors=4, seed=1)
+    dialogue = [e for e in examples if e.id == "d1"][0]
+    assert dialogue.history == DIALOGUE and dialogue.acts[0].label == "rejecting"
+    distractors = [e for e in examples if e.id.startswith("distractor-")]
+    assert len(distractors) == 4
+    assert all(e.history == DIALOGUE and e.acts[0].label == "welcoming" for e in distractors)
+
+
+def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, capsys, monkeypatch):
+    from emopose.planners.local_training import fit
+
+    rows = [("Welcome in, everyone!", "welcoming"), ("The exit is over there.", "pointing"),
+            ("No, don't touch that.", "rejecting"), ("Yes, exactly right.", "agreeing"),
+            ("Hmm, I doubt it.", "doubting")]
+    path = write_jsonl(tmp_path / "train.jsonl", [{"id": f"t{k}", "text": t, "label": c}
+                                                  for k, (t, c) in enumerate(rows)])
+    calls = {"lower": 0}
+    lower = model.lower
+
+    def counted(inputs):
+        calls["lower"] += 1
+        return lower(inputs)
+
+    monkeypatch.setattr(model, "lower", counted)
+    fit(model, load_examples([path], 0), {})
+    assert calls["lower"] == 2  # two batches of four, once each, for both epochs
+    err = capsys.readouterr().err
+    assert "frozen layers" in err and "epoch 1/2" in err and "epoch 2/2" in err
+    assert "<" in err  # tqdm's "elapsed<remaining": the ETA
