@@ -73,7 +73,10 @@ def summarize_turn(turn: Turn, turn_id: int, kind: str, audio_url: str | None, l
         "notes": plan["notes"], "cues": cue_rows(data),
         "speech": {"duration_s": speech["duration_s"] if speech else 0.0,
                    "estimated": speech["estimated"] if speech else True, "audio": audio_url},
-        "speech_start": submitted["speech_start"] if submitted else None,
+        # when the audio starts (or started) on the server clock: a streamed reply's later sentence
+        # waits for the one before it
+        "speech_start": data["dispatched"]["speech_start"] if "dispatched" in data
+        else submitted["speech_start"] if submitted else None,
         "planner_latency_s": output["latency_s"] if output else 0.0,
         "planner_error": output["error"] if output else None,
         "stage_ms": {k: round(v, 2) for k, v in data["stage_ms"].items()},

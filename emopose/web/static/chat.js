@@ -8,6 +8,7 @@ const history = $("history");
 const robot = new RobotPanel();
 let players = [];
 let pending = null;
+let replyOpen = false; // a streamed reply arrives sentence by sentence: its turns play one after another
 let libraryVersion = null;
 let plannerName = "";
 
@@ -39,8 +40,9 @@ function addTurn(turn, live) {
   const bubble = turnBubble(turn);
   history.append(bubble);
   if (live) {
-    players.forEach((p) => p.cancel()); // the server interrupted the previous reply
-    players = [new ReplyPlayer(bubble, turn)];
+    if (!replyOpen) { players.forEach((p) => p.cancel()); players = []; } // a new reply cut the previous one
+    players.push(new ReplyPlayer(bubble, turn)); // a later sentence starts at its own speech start
+    replyOpen = turn.kind === "say";
   } else showPlayed(bubble);
   scrollDown();
 }
@@ -60,6 +62,7 @@ function onMessage(msg) {
       loadMotions();
       break;
     case "turn_started":
+      replyOpen = false;
       history.append(userBubble(msg.utterance));
       history.lastElementChild.setAttribute("data-utterance", ""); // addTurn will not repeat it
       pending = el("div", { class: "bubble robot pending", text: "planning…" });

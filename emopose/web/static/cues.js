@@ -78,12 +78,15 @@ const lightAt = (cue) => cue.stroke_s ?? cue.release_s ?? 0;
 export class ReplyPlayer {
   constructor(bubble, turn) {
     this.bubble = bubble; this.turn = turn; this.done = false;
-    const ago = Math.max(0, (turn.now ?? turn.server_now) - (turn.speech_start ?? turn.server_now));
+    // Negative: the speech starts later (the next sentence of a streamed reply, queued behind this one).
+    const ago = (turn.now ?? turn.server_now) - (turn.speech_start ?? turn.server_now);
     this.t0 = performance.now() - ago * 1000;
     this.audio = null;
     if (turn.speech.audio) {
       this.audio = new Audio(turn.speech.audio);
-      this.audio.play().catch(() => { this.audio = null; }); // autoplay refused: keep the timer
+      const start = () => this.audio?.play().catch(() => { this.audio = null; }); // autoplay refused: keep the timer
+      if (ago < 0) this.timer = setTimeout(start, -ago * 1000);
+      else start();
     }
     this.end = Math.max(turn.speech.duration_s, ...turn.cues.map(lightAt)) + 0.3;
     requestAnimationFrame(() => this.tick());
@@ -103,7 +106,7 @@ export class ReplyPlayer {
       }
     }
     const bar = this.bubble.querySelector(".speechbar > div");
-    bar.style.width = `${Math.min(100, (100 * t) / Math.max(this.end, 0.01))}%`;
+    bar.style.width = `${Math.max(0, Math.min(100, (100 * t) / Math.max(this.end, 0.01)))}%`;
     if (t >= this.end) { this.done = true; return; }
     requestAnimationFrame(() => this.tick());
   }
@@ -111,6 +114,7 @@ export class ReplyPlayer {
   cancel() {
     if (this.done) return;
     this.done = true;
+    clearTimeout(this.timer);
     if (this.audio) this.audio.pause();
     this.bubble.querySelectorAll(".cue:not(.fired):not(.refused)").forEach((n) => n.classList.add("cancelled"));
   }
