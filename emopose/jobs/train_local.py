@@ -29,10 +29,12 @@ SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
 
 def context_metrics(planner: LocalPlanner, dialogues: list[Example]) -> dict:
     """Top-1 of the dialogue items read with and without their history (fractions)."""
-    def top1(with_history: bool) -> float:
+    def top1(with_history: bool) -> float | None:
+        if not dialogues:  # a planner trained without the dialogue split has none held out
+            return None
         first = [planner.best_split(planner.score(e.text, e.history if with_history else ()))[0]
                  for e in dialogues]
-        return sum(a.cls == e.acts[0].label for a, e in zip(first, dialogues)) / max(1, len(dialogues))
+        return sum(a.cls == e.acts[0].label for a, e in zip(first, dialogues)) / len(dialogues)
 
     return {"context_with_history": top1(True), "context_without": top1(False), "dialogues": len(dialogues)}
 
@@ -115,7 +117,8 @@ class TrainLocalJob:
         metrics = ("single_top1", "single_kept_whole", "sequence_exact", "anchor_recall", "exact_variant",
                    "context_with_history", "context_without")
         table = markdown_table(header, [[*(r[p] for p in SPLIT_PARAMETERS),
-                                         *(f"{100 * r[k]:.1f}%" for k in metrics)] for r in rows])
+                                         *("-" if r[k] is None else f"{100 * r[k]:.1f}%" for k in metrics)]
+                                        for r in rows])
         text = (f"Local planner on the held-out training slice ({rows[0]['singles']} single-act, "
                 f"{rows[0]['sequences']} multi-act, {rows[0]['dialogues']} dialogue items)\n\n{table}")
         config = planner.model.config
