@@ -113,7 +113,7 @@ class MujocoBackend(Backend):
         self._tau_limit = m.jnt_actfrcrange[[j.id for j in joints], 1]
         self._mjcf_servos = (m.actuator_gainprm[self._act, 0].copy(), -m.actuator_biasprm[self._act, 2].copy())
         self._mjcf_gravcomp = (m.body_gravcomp.copy(), m.jnt_actgravcomp.copy())
-        self._gravity = GravityModel(self.model_path)
+        self._gravity: GravityModel | None = None  # built the first time a law asks for a gravity torque
         self.apply_law(self.law)
         q0 = np.clip(self.initial_pose, self._lo, self._hi)
         self.data.qpos[self._qadr] = q0
@@ -175,7 +175,9 @@ class MujocoBackend(Backend):
             m.jnt_actgravcomp[:] = joints if builtin else 0
         self._kp, self._kv = np.maximum(kp, 1e-9), kv
         fed = replace(law, gravity_compensation=False) if own else law
-        self._feedforward = Feedforward(fed, self._gravity if law.gravity_compensation and not own else None)
+        if fed.gravity_compensation and self._gravity is None:
+            self._gravity = GravityModel(self.model_path)
+        self._feedforward = Feedforward(fed, self._gravity)
         self._feedforward.reset(self.data.qpos[self._qadr])
         self.law = law
 

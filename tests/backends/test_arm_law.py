@@ -91,3 +91,10 @@ def test_bad_laws_are_refused():
         ArmLaw("x", -1.0, 1.5)
     with pytest.raises(ValueError, match="tracking_lag_s"):
         ArmLaw("x", 60.0, 1.5, tracking_lag_s=2.0)
+
+
+def test_the_g1_refuses_a_law_without_gains_in_plain_words():
+    from emopose.backends.g1.backend import G1Backend
+
+    with pytest.raises(ValueError, match="arm_law=mjcf is simulator-only"):
+        G1Backend(kp=None, kd=None)

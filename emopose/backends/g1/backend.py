@@ -47,8 +47,8 @@ class G1Backend(Backend):
         network_interface: str | None = None,
         lowstate_timeout_s: float = 2.0,
         lowstate_loss_ms: float = 200.0,
-        kp: float | list[float] = 60.0,
-        kd: float | list[float] = 1.5,
+        kp: float | list[float] | None = 60.0,
+        kd: float | list[float] | None = 1.5,
         weight_ramp_up_s: float = 1.0,
         weight_ramp_down_s: float = 3.0,
         release_blend_s: float = 2.0,
@@ -64,6 +64,9 @@ class G1Backend(Backend):
         tracking_lag_s: float = 0.0,
         clock: Clock | None = None,
     ) -> None:
+        if kp is None or kd is None:  # arm_law=mjcf: the simulator's own servos have no gains to send
+            raise ValueError("g1 backend: the arm law gives no kp/kd (arm_law=mjcf is simulator-only); "
+                             "use arm_law=robot or robot_gravity")
         self.tracking_lag_s = tracking_lag_s
         self.settings = G1Settings.build(
             **{k: v for k, v in locals().items() if k not in ("self", "clock", "tracking_lag_s")}
