@@ -1,7 +1,9 @@
 """Latency of the local motion path: trajectory construction, command submission, self-collision check.
 
 construction  TrajectoryBuilder.build(keyframes, d, q_last) for every library sequence x intensity 1-5
-              (Eq. intensity applied first, not timed), from the neutral pose
+              (Eq. intensity applied first, not timed), from the neutral pose: the paper's path
+timed         TrajectoryBuilder.build_timed(...) of the same gestures placed by the timeline (a lone
+              gesture, its word 1 s in; the plan itself not timed): what the default schedule builds
 submission    Sequencer.submit(GestureCommand) on a dry_run loop (the paper's non-blocking hand-off)
 collision     SelfCollisionChecker.check(samples) on each constructed trajectory (the sequencer's safety
               hook, timed separately because the paper's construction figure does not include it)
@@ -34,8 +36,11 @@ from emopose.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
 from emopose.sequencer import Sequencer
+from emopose.contract import GestureRecord
 from emopose.stages.modulate import modulate_keyframes
+from emopose.timeline import TimelinePlanner, TimelineSettings
 from emopose.trajectory import TrajectoryBuilder
+from emopose.turn import ModulatedGesture, ResolvedGesture
 
 LIBRARY = Path(__file__).resolve().parents[1] / "library" / "g1"
 
@@ -73,6 +78,14 @@ def main() -> None:
             build_s.append(dt)
             per_motion.setdefault(entry.name, []).append(dt)
             check_s.append(timed(checker.check, trajectory.samples)[0])
+    planner, timed_s = TimelinePlanner(builder, TimelineSettings()), []
+    for entry, level, keyframes in cases:
+        record = GestureRecord(cls=entry.cls, variant=entry.name, intensity=level)
+        gesture = ModulatedGesture(ResolvedGesture(record, entry, "exact"), keyframes, entry.default_duration)
+        (timing,), _ = planner.plan([gesture], [1.0])
+        times = np.asarray(timing.times[1:]) - timing.times[0]
+        builder.build_timed(timing.keyframes, times, neutral)  # warm-up
+        timed_s += [timed(builder.build_timed, timing.keyframes, times, neutral)[0] for _ in range(args.repeats)]
     # Submission: the hand-off into the queue, with a loop ticking between submissions as in a session.
     sequencer = Sequencer(builder, neutral)
     loop = ControlLoop(sequencer, DryRunBackend(), FakeClock())
@@ -90,6 +103,7 @@ def main() -> None:
         "motions": len({e.name for e, _, _ in cases}), "cases": len(cases), "repeats": args.repeats,
         "scheduling": scheduling, "load_avg_1min": os.getloadavg()[0],
         "construction_ms": stats(build_s),
+        "timed_construction_ms": stats(timed_s),
         "submission_ms": stats(submit_s),
         "collision_check_ms": stats(check_s),
         "slowest_motion": {"name": slowest, **stats(per_motion[slowest])},
