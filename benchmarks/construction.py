@@ -31,12 +31,12 @@ from control_loop import realtime_priority  # benchmarks/ is on sys.path when ru
 
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
+from emopose.contract import GestureRecord
 from emopose.control_loop import ControlLoop
 from emopose.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
 from emopose.sequencer import Sequencer
-from emopose.contract import GestureRecord
 from emopose.stages.modulate import modulate_keyframes
 from emopose.timeline import TimelinePlanner, TimelineSettings
 from emopose.trajectory import TrajectoryBuilder
