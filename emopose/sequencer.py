@@ -33,9 +33,9 @@ from enum import StrEnum
 
 import numpy as np
 
-from emopose import STROKE_TOLERANCE
 from emopose.bounded_log import BoundedLog
 from emopose.gesture_command import Event, GestureCommand
+from emopose.stroke_sync import first_within
 from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 
@@ -230,10 +230,9 @@ class Sequencer:
         if command.stroke is None:
             return -1
         start = command.stroke[0]
-        keyframe = np.asarray(command.keyframes)[start]
         reached = motion.anchor_ticks[max(start, 1)]
-        close = np.max(np.abs(motion.samples[1:reached + 1] - keyframe), axis=1) <= STROKE_TOLERANCE
-        return 1 + int(np.argmax(close)) if close.any() else reached
+        hit = first_within(motion.samples[1:reached + 1], np.asarray(command.keyframes)[start])
+        return reached if hit is None else 1 + hit
 
     def _begin_or_hold(self, command: GestureCommand, now: float) -> None:
         if not self._begin(command, now):

@@ -60,13 +60,18 @@ def planned_strokes(turn) -> list[PlannedStroke]:
     return out
 
 
+def first_within(stream: np.ndarray, keyframe: np.ndarray, tolerance: float = STROKE_TOLERANCE) -> int | None:
+    """Index of the first (T, 14) sample with every joint within `tolerance` of `keyframe`, else None."""
+    hits = np.flatnonzero(np.max(np.abs(stream - keyframe), axis=1) <= tolerance)
+    return int(hits[0]) if hits.size else None
+
+
 def first_arrival(times: np.ndarray, stream: np.ndarray, keyframe: np.ndarray, start: float, end: float,
                   tolerance: float) -> float | None:
     """Time of the first sample in [start, end] within `tolerance` of `keyframe`, else None."""
-    inside = (times >= start - 1e-9) & (times <= end + 1e-9)
-    close = inside & (np.max(np.abs(stream - keyframe), axis=1) <= tolerance)
-    hits = np.flatnonzero(close)
-    return float(times[hits[0]]) if hits.size else None
+    inside = np.flatnonzero((times >= start - 1e-9) & (times <= end + 1e-9))
+    hit = first_within(stream[inside], keyframe, tolerance) if inside.size else None
+    return None if hit is None else float(times[inside[hit]])
 
 
 @dataclass(frozen=True)
