@@ -80,7 +80,9 @@ class FakeRobot:
     def entries(self, kind: str | None = None) -> list[dict]:
         if not self.log_path.exists():
             return []
-        rows = [json.loads(line) for line in self.log_path.read_text().splitlines() if line.strip()]
+        # The robot may be appending: only lines it has finished (newline-terminated) are read.
+        complete = self.log_path.read_text().split("\n")[:-1]
+        rows = [json.loads(line) for line in complete if line.strip()]
         return [r for r in rows if kind is None or r["kind"] == kind]
 
     def wait_for(self, kind: str, count: int, timeout_s: float = 5.0) -> list[dict]:
