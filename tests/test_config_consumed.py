@@ -126,5 +126,12 @@ def test_the_group_is_built_into_the_run(group, option, tmp_path, monkeypatch):
         consumer(cfg, run)
 
 
+def test_a_laws_tracking_lag_reaches_the_backend_and_the_timeline(tmp_path):
+    cfg = compose_config(["planner=keyword", "backend=mujoco", "arm_law=robot_gravity"])
+    assert cfg.arm_law.tracking_lag_s > 0  # the default law's lag is 0, which would prove nothing
+    with build_run(cfg, tmp_path) as run:
+        arm_law_applied_by_the_simulator(cfg, run)
+
+
 def test_every_consumer_names_a_group_in_the_defaults():
     assert set(CONSUMERS) <= set(DEFAULTS), f"stale entries: {sorted(set(CONSUMERS) - set(DEFAULTS))}"

@@ -2,8 +2,8 @@
 
 Each send(t, q) is one control period: the 14 targets become the servos' setpoints and physics
 advances CONTROL_DT in `substeps` steps. The servos follow the arm law (emopose/robot/arm_law.py,
-conf/arm_law/): by default the G1's own command law (kp 60, kd 1.5, dq = tau = 0: no gravity
-compensation, no velocity feed-forward), so the arms lag and sag as the robot's do; `arm_law=mjcf`
+conf/arm_law/): by default the law the G1 is sent (kp 60, kd 1.5, with the gravity and velocity
+feed-forwards), so the arms track as the robot's do (`arm_law=robot_plain`: sag and lag); `arm_law=mjcf`
 restores the MJCF's stiffer servos, gravity compensated through the actuators (body gravcomp + joint
 actuatorgravcomp, so the compensating torque shares each joint's torque limit), tracking (q, dq) with
 dq the stream's finite difference. `apply_law()` switches laws on a connected model (sim_suite

@@ -1,10 +1,12 @@
 """The arm motors' control law: one definition for what the G1 is sent and what MuJoCo applies.
 
 The G1's motors run tau = kp (q* - q) + kd (dq* - dq) + tau_ff; EmoPose's G1 backend sends kp, kd, the
-position q* and dq* = tau_ff = 0 (Unitree's arm example). `robot` (conf/arm_law/robot.yaml, the
-default) is that law, so the simulator tracks like the robot: its lag and gravity sag shift when a
-stroke is reached. `mjcf` keeps the model's own stiffer servos with gravity compensation and a
-velocity feed-forward, as the simulator ran before; it is optimistic and kept for comparison.
+position q* and, as the law says, dq* (the stream's velocity) and tau_ff (the model's gravity torque).
+`robot` (conf/arm_law/robot.yaml, the default) sends both, so the arm neither sags nor trails;
+`robot_plain` is Unitree's arm example (dq* = tau_ff = 0) and `robot_gravity` the gravity torque alone.
+MuJoCo applies the configured law, so the simulator tracks like the robot. `mjcf` keeps the model's own
+stiffer servos with gravity compensation and a velocity feed-forward, as the simulator ran before; it is
+optimistic and kept for comparison.
 `tracking_lag_s` is how long the joints trail the command stream under this law (measured with
 sync_eval on MuJoCo); the timeline plans that much ahead on backends with actuators.
 """

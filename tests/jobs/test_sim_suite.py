@@ -18,7 +18,6 @@ from emopose.trajectory import TrajectoryBuilder
 from tests.jobs.sim_helpers import compose_config
 
 TRACKING_BOUND_RAD = 0.010  # the suite's MAE target, per class default at level 3, under the MJCF's servos
-ROBOT_LAW_BOUND_RAD = 0.020  # the same under the G1's own law (kp 60, kd 1.5, no feed-forward)
 
 
 @pytest.fixture(scope="module")
@@ -54,11 +53,12 @@ def test_sim_suite_eight_trials_end_to_end(tmp_path):
     assert saved["trials"] == saved["completed"] == 8
     assert saved["stops"] == saved["timeouts"] == saved["rejected"] == 0
     assert set(saved["per_class_mae_rad"]) == set(CLASSES)  # 8 trials = one per class
-    # Under the G1's command law (the default) the simulator tracks like the robot: several times worse
-    # than the MJCF's own stiffer, gravity-compensated servos, which the suite runs again for comparison.
+    # Under the G1's command law (the default: kp 60 with gravity and velocity feed-forwards) the
+    # simulator tracks within 2x of the MJCF's own stiffer servos, which the suite runs again for
+    # comparison (Unitree's plain example law, without the feed-forwards, is about 3x worse).
     assert saved["arm_law"] == "robot" and saved["compare"]["arm_law"] == "mjcf"
     assert 0 < saved["compare"]["mae_rad"] <= TRACKING_BOUND_RAD and saved["compare"]["completed"] == 8
-    assert 2 * saved["compare"]["mae_rad"] < saved["mae_rad"] <= ROBOT_LAW_BOUND_RAD
+    assert 0 < saved["mae_rad"] < 2 * saved["compare"]["mae_rad"]
     assert saved["mae_time_aligned_rad"] > saved["mae_rad"]  # wall-clock pairing adds a period of lag
     assert saved["max_actuator_force_ratio"] <= 1.0 + 1e-9
     for key in ("construction_ms", "submission_ms"):

@@ -1,7 +1,7 @@
 """Builds the LowCmd_ that goes on rt/arm_sdk: arm targets, arm_sdk weight, gains, CRC.
 
 Only motors 15-28 (and, when asked, the waist 12-14) get mode=1, q, kp, kd, and the arm law's
-dq and tau feed-forwards (0 under the default law, as Unitree's arm example sends them);
+dq and tau feed-forwards (0 under arm_law=robot_plain, as Unitree's arm example sends them);
 motor 29 carries the weight in its q; every other motor stays all-zero so the firmware keeps
 the legs. One preallocated record is reused: a command costs a few vectorised assignments,
 a ~7 us CRC and a byte copy, which keeps send() far below the 20 ms tick.

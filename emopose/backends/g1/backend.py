@@ -66,7 +66,7 @@ class G1Backend(Backend):
     ) -> None:
         if kp is None or kd is None:  # arm_law=mjcf: the simulator's own servos have no gains to send
             raise ValueError("g1 backend: the arm law gives no kp/kd (arm_law=mjcf is simulator-only); "
-                             "use arm_law=robot or robot_gravity")
+                             "use arm_law=robot, robot_gravity or robot_plain")
         self.tracking_lag_s = tracking_lag_s
         self.settings = G1Settings.build(
             **{k: v for k, v in locals().items() if k not in ("self", "clock", "tracking_lag_s")}
