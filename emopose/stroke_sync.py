@@ -17,6 +17,7 @@ import numpy as np
 from emopose import STROKE_TOLERANCE
 
 WINDOW_S = (-0.2, 0.1)  # a stroke belongs to its word when it lands 200 ms before to 100 ms after the onset
+EDGE_MS = 1e-3  # stream times carry ~1e-12 s of float noise: a stroke on a window edge is inside it
 ENDS = ("completed", "cut", "stopped")
 
 
@@ -125,7 +126,8 @@ def stroke_summary(rows: list[StrokeSync], simulated: bool = False) -> dict:
         "median_abs_ms": stat(lambda x: np.median(np.abs(x))),
         "p95_abs_ms": stat(lambda x: np.percentile(np.abs(x), 95)),
         "median_signed_ms": stat(np.median),
-        "within_window_share": float(np.sum((offsets >= low) & (offsets <= high)) / n) if n else None,
+        "within_window_share": float(np.sum((offsets >= low - EDGE_MS) & (offsets <= high + EDGE_MS)) / n)
+        if n else None,
         "dropped_share": sum(r.dropped is not None for r in planned) / n if n else None,
         "preroll_p95_ms": float(np.percentile(prerolls, 95)),
         "window_ms": [low, high],
