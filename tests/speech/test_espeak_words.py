@@ -10,6 +10,7 @@ import pytest
 
 from emopose.speech import espeak_lib
 from emopose.speech.espeak import EspeakSynthesizer
+from emopose.speech.word_events import clean_events
 
 REPLIES = [
     "Welcome to the lab! The robot arm is over there.",
@@ -101,9 +102,11 @@ def test_concurrent_synthesis_is_serialised_and_correct(tmp_path):
         t.join()
     assert not errors and set(results) == set(expected)
     for text, events in results.items():
-        # espeak carries a little state from the previous text: onsets may move by ~10 ms between renders
-        assert [e.char_index for e in events] == [e.char_index for e in expected[text]]
-        assert all(abs(a.audio_s - b.audio_s) <= 0.02 for a, b in zip(events, expected[text]))
+        # espeak carries a little state from the previous text: onsets may move by ~10 ms between renders,
+        # and now and then it reports a word before the text (char -1), which clean_events drops
+        got, want = clean_events(text, events), clean_events(text, expected[text])
+        assert list(got) == list(want) and len(got) == 7
+        assert all(abs(got[i] - want[i]) <= 0.02 for i in want)
 
 
 def test_voice_rate_pitch_are_applied_and_validated(tmp_path):
