@@ -17,6 +17,9 @@ backwards from there. Gestures are placed in the order of their words, each agai
 The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
 preparation needs more, it is compressed (down to `scale[0]`), then shortened to one segment straight
 to the stroke start ("direct", for strokes after several preparation keyframes), and then lands late.
+Its first segment starts from wherever the arm is at its start time; when the arm is away from rest at
+planning time (a reply interrupting motion, or the thinking gesture, which then blend back to rest), that
+segment is made long enough from the arm's pose too, so the sequencer never has to slow it down.
 `lag_s` moves everything earlier to absorb the actuators' tracking lag (0 for a command stream).
 """
 
@@ -83,13 +86,15 @@ class TimelinePlanner:
         knots = np.arange(builder.increments + 1) / builder.increments
         self._smooth_curve = np.interp(_U, knots, smoothstep(knots))  # the waypoint easing G samples
 
-    def plan(self, gestures: list[ModulatedGesture], onsets: list[float]) -> tuple[list[GestureTiming | str], float]:
-        """Timing (or a drop reason) per gesture, in the given order, and the speech pre-roll (s)."""
+    def plan(self, gestures: list[ModulatedGesture], onsets: list[float],
+             arm: np.ndarray | None = None) -> tuple[list[GestureTiming | str], float]:
+        """Timing (or a drop reason) per gesture, in the given order, and the speech pre-roll (s).
+        `arm`: the arm's pose now, if it may not be at rest when the first gesture starts."""
         out: list[GestureTiming | str] = [""] * len(gestures)
         placed: list[tuple[int, _Placed]] = []
         for k in sorted(range(len(gestures)), key=lambda k: onsets[k]):
             aim = onsets[k] + self.settings.lead_s - self.settings.lag_s
-            gesture = self._place(gestures[k], aim, placed[-1][1] if placed else None)
+            gesture = self._place(gestures[k], aim, placed[-1][1] if placed else None, arm)
             if isinstance(gesture, str):
                 out[k] = gesture
             else:
@@ -100,14 +105,18 @@ class TimelinePlanner:
         return out, preroll
 
     # -- placing one gesture -------------------------------------------------------------------------
-    def _place(self, gesture: ModulatedGesture, aim: float, prev: _Placed | None) -> _Placed | str:
+    def _place(self, gesture: ModulatedGesture, aim: float, prev: _Placed | None,
+               arm: np.ndarray | None) -> _Placed | str:
         anchors, stroke, step = self._shape(gesture)
         low, high = self.settings.scale
         name = gesture.name
         if prev is None:
+            # origins stacked (m, 14): segment bounds and approach distances take the farthest one; a
+            # blend from `arm` back to rest stays between the two, so both bounds cover it
+            origins = anchors[:1] if arm is None else np.vstack([anchors[0], arm])
             earliest = -self.settings.max_preroll_s
-            placed = self._prepare(name, anchors, stroke, step, anchors[0], False, earliest, aim, (1.0, low))
-            return placed or self._late(name, anchors, stroke, step, earliest, aim)
+            placed = self._prepare(name, anchors, stroke, step, origins, False, earliest, aim, (1.0, low))
+            return placed or self._late(name, anchors, stroke, step, origins, earliest, aim)
         placed = self._prepare(name, anchors, stroke, step, anchors[0], False, prev.times[-1], aim, (1.0, 1.0))
         if placed is not None:
             return placed
@@ -176,13 +185,13 @@ class TimelinePlanner:
                                         blend_in, float(scale))
         return None
 
-    def _late(self, name, anchors, stroke, step, start, aim) -> _Placed:
+    def _late(self, name, anchors, stroke, step, origins, start, aim) -> _Placed:
         """The first gesture when even the pre-roll and the fastest preparation cannot meet its word."""
         low = self.settings.scale[0]
-        durations = self._durations(anchors, anchors[0], 0, stroke[0], step * low, False)
-        arrival = start + sum(durations) - self._approach(anchors[stroke[0] - 1], anchors[stroke[0]],
-                                                          durations[-1], False)
-        return self._finish(name, anchors, stroke, step, anchors[0], start, durations, aim, arrival, "late",
+        durations = self._durations(anchors, origins, 0, stroke[0], step * low, False)
+        before = origins if stroke[0] == 1 else anchors[stroke[0] - 1]
+        arrival = start + sum(durations) - self._approach(before, anchors[stroke[0]], durations[-1], False)
+        return self._finish(name, anchors, stroke, step, origins, start, durations, aim, arrival, "late",
                             False, low)
 
     def _finish(self, name, anchors, stroke, step, start_pose, start, prep, aim, arrival, fit, blend_in,

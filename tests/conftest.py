@@ -19,7 +19,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 os.environ.setdefault("HYDRA_FULL_ERROR", "1")
 
 from emopose import CLASSES  # noqa: E402
-from emopose.config import CONFIG_DIR  # noqa: E402
+from emopose.config import CONFIG_DIR, project_path  # noqa: E402
 from emopose.library import MotionLibrary  # noqa: E402
 
 LOWER = [-3.0892, -1.5882, -2.618, -1.0472, -1.97222, -1.61443, -1.61443,
@@ -87,6 +87,13 @@ def load_library(folder: Path) -> MotionLibrary:
 def library(tmp_path_factory) -> MotionLibrary:
     """Read-only shared library; tests that save motions use `writable_library`."""
     return load_library(make_library_dir(tmp_path_factory.mktemp("lib") / "library"))
+
+
+@pytest.fixture(scope="session")
+def g1() -> MotionLibrary:
+    """The shipped G1 library (timing tests need its real strokes, durations and speed bounds)."""
+    return MotionLibrary.from_config(paths=[str(project_path("library/g1"))],
+                                     limits=str(project_path("library/g1/limits.yaml")))
 
 
 @pytest.fixture

@@ -40,7 +40,7 @@ def wire(library, run_dir, *, planner=None, synthesizer=None, backend=None, mode
     sequencer = Sequencer(TrajectoryBuilder(library.limits), library.neutral_entry.q[0])
     loop, player = ControlLoop(sequencer, backend or DryRunBackend(), clock), Player(sink="none")
     stages = [Parse(), Resolve(library), Modulate(library.limits),
-              ScheduleStage(synthesizer or EstimatedSpeech(), library.limits, mode=mode),
+              ScheduleStage(synthesizer or EstimatedSpeech(), library.limits, sequencer=sequencer, mode=mode),
               SequenceStage(sequencer, clock, player), Dispatch(loop, player, until=until)]
     session = Session(loop.backend, loop, library.neutral_entry.q[0], run_dir, record=record)
     runner = TurnRunner(planner or KeywordPlanner(), Pipeline(stages), session)

@@ -8,7 +8,8 @@ released at once. words mode uses the synthesizer's true onset of the trigger's 
 back to the anchor equation where it has no word timings. Trigger search is case-insensitive.
 timeline mode (the default, beyond the paper) takes the words-mode times as the onsets the strokes must
 meet and plans every gesture's keyframe times around them (emopose/timeline.py); its release is the
-gesture's start, possibly before the speech (the pre-roll).
+gesture's start, possibly before the speech (the pre-roll); the sequencer's published pose tells it
+where the arm is, so a first gesture that starts away from rest still lands on its word.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from typing import Literal
 import numpy as np
 
 from emopose.library import JointLimits
+from emopose.sequencer import Sequencer
 from emopose.speech.clip import SpeechClip, Synthesizer
 from emopose.timeline import TimelinePlanner, TimelineSettings
 from emopose.trajectory import TrajectoryBuilder
@@ -78,11 +80,13 @@ def word_release_times(reply: str, triggers: list[str | None], speech: SpeechCli
 class ScheduleStage:
     """Stage: plan + modulated -> speech + schedule. Its synthesizer gives the reply's audio, T_a and
     word onsets; `limits` bound the timeline's joint speeds (the same bound the sequencer builds with) and
-    `safety` (the sequencer's check) vets its co-articulation blends."""
+    `safety` (the sequencer's check) vets its co-articulation blends; `sequencer` (read only) tells the
+    timeline where the arm is."""
 
     synthesizer: Synthesizer = field(repr=False)
     limits: JointLimits = field(repr=False)
     safety: Callable[[np.ndarray], str | None] | None = field(default=None, repr=False)
+    sequencer: Sequencer | None = field(default=None, repr=False)
     mode: Literal["anchor", "words", "timeline"] = "timeline"
     timeline: TimelineSettings = field(default_factory=TimelineSettings)
     name = "schedule"
@@ -106,7 +110,8 @@ class ScheduleStage:
         if self.mode != "timeline":
             releases = tuple(Release(t, how, ok) for (t, how), ok in zip(times, found))
             return speech, Schedule(reply, releases, tuple(turn.modulated))
-        placed, preroll = self._planner.plan(list(turn.modulated), [t for t, _ in times])
+        arm = None if self.sequencer is None else self.sequencer.last
+        placed, preroll = self._planner.plan(list(turn.modulated), [t for t, _ in times], arm)
         releases = tuple(
             Release(timing.times[0], how, ok, timing=timing) if not isinstance(timing, str)
             else Release(t, how, ok, dropped=timing)

@@ -1,5 +1,3 @@
-from pathlib import Path
-
 import pytest
 
 from emopose.contract import GestureRecord
@@ -8,20 +6,12 @@ from emopose.stages.modulate import modulate_keyframes
 from emopose.turn import ModulatedGesture, ResolvedGesture
 from tests.wiring import wire
 
-ROOT = Path(__file__).resolve().parents[2]
-
 
 @pytest.fixture
 def wired(library, tmp_path):
     built = wire(library, tmp_path)
     with built.session:
         yield built
-
-
-@pytest.fixture(scope="session")
-def g1() -> MotionLibrary:
-    """The shipped G1 library (timing tests need its real strokes, durations and speed bounds)."""
-    return MotionLibrary.from_config(paths=[str(ROOT / "library/g1")], limits=str(ROOT / "library/g1/limits.yaml"))
 
 
 def gesture(library: MotionLibrary, name: str, intensity: int = 3) -> ModulatedGesture:

@@ -34,20 +34,20 @@ class SlowPlanner:
 
     name = "slow"
 
-    def __init__(self, latency_s: float) -> None:
-        self.latency_s, self.loop = latency_s, None
+    def __init__(self, latency_s: float, raw: str = PLAN) -> None:
+        self.latency_s, self.raw, self.loop = latency_s, raw, None
 
     def plan(self, request) -> PlannerOutput:
         self.loop.run_until(lambda: False, self.latency_s)
-        return PlannerOutput(raw=PLAN, latency_s=self.latency_s)
+        return PlannerOutput(raw=self.raw, latency_s=self.latency_s)
 
 
-def make_run(library, espeak, tmp_path, latency_s):
-    planner = SlowPlanner(latency_s)
-    run = wire(library, tmp_path, planner=planner, synthesizer=espeak, backend=RecordingBackend(), mode="words",
+def make_run(library, espeak, tmp_path, latency_s, mode="words", plan=PLAN, thinking="doubting_a"):
+    planner = SlowPlanner(latency_s, plan)
+    run = wire(library, tmp_path, planner=planner, synthesizer=espeak, backend=RecordingBackend(), mode=mode,
                record=False)
     planner.loop = run.loop
-    run.runner.thinking = ThinkingGesture(library, run.sequencer, run.loop.clock, "doubting_a", repeats=3)
+    run.runner.thinking = ThinkingGesture(library, run.sequencer, run.loop.clock, thinking, repeats=3)
     return run
 
 
@@ -96,3 +96,24 @@ def test_unknown_motion_is_refused_at_build_time(library, tmp_path):
     run = wire(library, tmp_path)
     with pytest.raises(ValueError, match="thinking.motion 'chin_strok'"):
         ThinkingGesture(library, run.sequencer, run.loop.clock, "chin_strok")
+
+
+
+@pytest.mark.parametrize("latency_s", [0.6, 2.5])  # mid-motion; mid-blend between two repeats
+def test_a_first_gesture_starting_from_the_thinking_pose_lands_where_the_timeline_planned_it(
+        g1, espeak, tmp_path, latency_s):
+    """The plan interrupts the thinking gesture and its first stroke is on the first word, so that gesture
+    prepares from wherever the arm is; the timeline, told the arm's pose, plans for it (it used to plan
+    from rest and the stroke came ~180 ms after its planned time)."""
+    plan = json.dumps({"reply": REPLY, "gestures": [
+        {"class": "doubting", "variant": "palm_tilt_waver", "intensity": 3, "trigger": "Welcome"}]})
+    run = make_run(g1, espeak, tmp_path, latency_s, mode="timeline", plan=plan, thinking="chin_stroke")
+    turn = run.runner.run("Hello robot, where is the arm?")
+    assert events_of(run, "started", "chin_stroke")
+    first = turn.submitted.commands[0]
+    arrival = turn.submitted.speech_start + turn.schedule.releases[0].timing.arrival_s
+    stroke = [e.t for e in events_of(run, "stroke") if e.command_id == first.id]
+    # never later than planned but for the 50 Hz quantisation (the start and the arrival each fall on a
+    # tick: up to two periods, as without thinking); a little early where the arm started closer to the
+    # stroke than the farthest pose planned for
+    assert stroke and -0.1 <= stroke[0] - arrival <= 2 * run.loop.dt + 1e-9
