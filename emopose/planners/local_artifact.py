@@ -18,7 +18,7 @@ from emopose.planners.local_context_model import ActModel
 from emopose.planners.local_data import load_examples
 
 log = logging.getLogger(__name__)
-ARTIFACT_VERSION = 8
+ARTIFACT_VERSION = 9
 
 
 def artifact_path(paths: list[str], cache_dir: str | Path, config: TrainingConfig) -> Path:

@@ -6,6 +6,8 @@ trains a new model, the old artifact stays on disk.
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field
 
 
@@ -21,6 +23,7 @@ class TrainingConfig(BaseModel):
     trainable_layers: int = Field(2, ge=1, le=6)  # top encoder layers fine-tuned; the rest run once, cached
     lr: float = Field(1e-4, ge=0)
     head_lr: float = Field(2e-3, ge=0)
+    lr_schedule: Literal["constant", "linear"] = "constant"  # linear: warm up over 5 % of steps, then decay to 0
     batch_size: int = Field(32, ge=1)
     logit_scale: float = Field(20.0, gt=0)
     anchor_loss_weight: float = Field(0.5, ge=0)

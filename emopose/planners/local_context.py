@@ -5,7 +5,8 @@ anchor-head triggers) from a different model (planners/local_context_model.py):
 
 - one forward pass over the last dialogue turns and the utterance as one input with role markers,
   trained on the dialogue split experiments/train/context/ as well (an elliptical "That one, with the
-  feathers." is read in context; unrelated histories are trained not to sway a clear utterance);
+  feathers." is read in context; unrelated histories before single- and multi-act training items teach
+  it that a history which does not bear on the utterance sways neither its classes nor its split);
 - the variant is the class member whose projected description is nearest the act's projected vector
   in the pretrained sentence space (descriptions come from the live library, so a new variant is
   selectable without retraining; the projection is trained with motions left out per batch);
@@ -52,16 +53,10 @@ class LocalContextPlanner(LocalPlanner):
         self._variant_vectors = (-1, {})
 
     def score(self, utterance: str, history: tuple[dict, ...] = ()) -> ScoredUtterance:
-        """Everything the split needs from the model: one forward pass, two with a history. The model
-        learnt dialogue context on single-act replies only, and read in context a multi-act utterance
-        after an unrelated dialogue lost its split (sequence suite ordered exact 75.9 % -> 26.3 %). So
-        the history is used only when the utterance read alone is one act; then all of it is re-read
-        after the dialogue."""
-        analyses = self.model.analyse([utterance] * (2 if history else 1), [(), history] if history else None)
-        alone = self._scored(utterance, analyses[0])
-        if not history or len(self.best_split(alone)) > 1:
-            return alone
-        return self._scored(utterance, analyses[1])
+        """Everything the split needs from the model: one forward pass over the dialogue and the
+        utterance. Unrelated histories before single- and multi-act items are part of training
+        (planners/local_data.py), so the split is read in context too."""
+        return self._scored(utterance, self.model.analyse([utterance], [history])[0])
 
     def _scored(self, utterance: str, analysis) -> ScoredUtterance:
         pieces = segments(utterance) or [Segment(utterance, 0, len(utterance), True)]

@@ -11,8 +11,9 @@ the planner can choose at run time:
   ("; ", ", but ", ". ", ...), so the boundary model sees many more act changes than the hand-written
   sequences alone hold;
 - a dialogue item (train/context/) is one act over its final utterance, read after its history;
-- distractors give single-act items the history of an unrelated dialogue, label unchanged, so the
-  model learns that a history which does not bear on the utterance must not sway it.
+- distractors give training items (single- and multi-act, synthetic too) the history of an unrelated
+  dialogue, labels unchanged, so the model learns that a history which does not bear on the utterance
+  must sway neither its classes nor its split.
 
 Items whose id hashes into the held-out bucket never enter training (the quality check scores them).
 """
@@ -22,7 +23,7 @@ from __future__ import annotations
 import hashlib
 import json
 import random
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from emopose import CLASSES
@@ -154,14 +155,15 @@ def synthetic_sequences(singles: list[Example], count: int, seed: int) -> list[E
     return out
 
 
-def context_distractors(singles: list[Example], dialogues: list[Example], count: int,
+def context_distractors(items: list[Example], dialogues: list[Example], count: int,
                         seed: int) -> list[Example]:
-    """`count` single-act items, each after the history of a randomly drawn dialogue."""
+    """`count` examples drawn from items (single- and multi-act, no history), each after the history of
+    a randomly drawn dialogue; acts, anchors and variants unchanged."""
     rng = random.Random(seed)
-    if not singles or not dialogues:
+    if not items or not dialogues:
         return []
-    return [single_act(f"distractor-{n}", item.text, item.acts[0].label, rng.choice(dialogues).history)
-            for n, item in enumerate(rng.choices(singles, k=count))]
+    return [replace(item, id=f"distractor-{n}", history=rng.choice(dialogues).history)
+            for n, item in enumerate(rng.choices(items, k=count))]
 
 
 def load_examples(paths: list[str], holdout_percent: int, held_out: bool = False,
@@ -188,5 +190,6 @@ def load_examples(paths: list[str], holdout_percent: int, held_out: bool = False
     if not held_out:
         singles = [e for e in examples if len(e.acts) == 1 and not e.history]
         examples += synthetic_sequences(singles, synthetic, seed) if synthetic else []
-        examples += context_distractors(singles, [e for e in examples if e.history], distractors, seed)
+        dialogues = [e for e in examples if e.history]
+        examples += context_distractors([e for e in examples if not e.history], dialogues, distractors, seed)
     return examples

@@ -25,7 +25,7 @@ def planner(request, tmp_path_factory):
 
 
 # Target of the planner issue, not reached yet: measured picks out of 5 (sailor_salute, thumbs_up, finger_wag,
-# head_scratch, point_down) are 2/2/1/0/4 with planner=local and 5/3/2/0/3 with planner=local_context (most
+# head_scratch, point_down) are 2/2/1/0/4 with planner=local and 5/3/1/1/4 with planner=local_context (most
 # misses there are class errors: "I'm baffled" read as rejecting). Strict: a pass fails, so the mark goes.
 @pytest.mark.xfail(strict=True, reason="new motions are not yet picked for >= 80 % of their utterances")
 @pytest.mark.slow

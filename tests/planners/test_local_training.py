@@ -47,12 +47,19 @@ def test_dialogue_items_and_distractors_are_training_examples(tmp_path):
         {"id": f"s{k}", "text": f"Welcome aboard, guest {k}.", "label": "welcoming"} for k in range(6)])
     dialogues = write_jsonl(tmp_path / "dialogues.jsonl", [
         {"id": "d1", "history": list(DIALOGUE), "text": "Absolutely not.", "label": "rejecting"}])
-    examples = load_examples([singles, dialogues], 0, distractors=4, seed=1)
+    sequence = write_jsonl(tmp_path / "sequence.jsonl", [
+        {"id": "q1", "text": "Hi Marisol, lovely to see you! Your locker is the grey one on your left.",
+         "labels": ["welcoming", "pointing"], "anchors": ["Hi Marisol", "the grey one on your left"]}])
+    examples = load_examples([singles, dialogues, sequence], 0, distractors=40, seed=1)
     dialogue = [e for e in examples if e.id == "d1"][0]
     assert dialogue.history == DIALOGUE and dialogue.acts[0].label == "rejecting"
     distractors = [e for e in examples if e.id.startswith("distractor-")]
-    assert len(distractors) == 4
-    assert all(e.history == DIALOGUE and e.acts[0].label == "welcoming" for e in distractors)
+    assert len(distractors) == 40 and all(e.history == DIALOGUE for e in distractors)
+    assert {e.acts[0].label for e in distractors if len(e.acts) == 1} == {"welcoming"}
+    # a multi-act item keeps its split and anchors after the unrelated history (history must not sway it)
+    original = [e for e in examples if e.id == "q1"][0]
+    assert any((e.text, e.acts, e.anchors) == (original.text, original.acts, original.anchors)
+               for e in distractors)
 
 
 def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, capsys, monkeypatch):
@@ -71,8 +78,20 @@ def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, 
         return lower(inputs)
 
     monkeypatch.setattr(model, "lower", counted)
+    attention = model.body.config._attn_implementation
     fit(model, load_examples([path], 0), {})
     assert calls["lower"] == 2  # two batches of four, once each, for both epochs
+    assert model.body.config._attn_implementation == attention  # training's eager attention is undone
     err = capsys.readouterr().err
     assert "frozen layers" in err and "epoch 1/2" in err and "epoch 2/2" in err
     assert "<" in err  # tqdm's "elapsed<remaining": the ETA
+
+
+def test_linear_schedule_warms_up_then_decays_to_zero():
+    from emopose.planners.local_training import learning_rate_factor
+
+    factor = learning_rate_factor(TrainingConfig(lr_schedule="linear"), 100)
+    rates = [factor(step) for step in range(100)]
+    assert rates[0] == pytest.approx(0.2) and rates[4] == pytest.approx(1.0)  # 5 warm-up steps
+    assert all(a >= b for a, b in zip(rates[4:], rates[5:])) and rates[-1] == pytest.approx(1 / 95)
+    assert {learning_rate_factor(TrainingConfig(), 100)(step) for step in range(100)} == {1.0}
