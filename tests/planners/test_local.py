@@ -87,17 +87,26 @@ def test_train_local_search_is_checked_before_anything_is_built():
         TrainLocalJob(search={"act_cost": -1.0})
 
 
-@pytest.mark.parametrize("override, message", [
-    ("planner.training.split_loss_weight=abc", "split_loss_weight must be a number, got 'abc'"),
-    ("planner.training.seed=1.5", "seed must be an integer"),
-    ("planner.training.epochs=0", "epochs, batch_size and trainable_layers at least 1"),
-    ("planner.training.lr=-0.1", "lr must not be negative"),
-    ("planner.temperature=0", "temperature must be positive"),
+@pytest.mark.parametrize("planner, override, message", [
+    ("local", "planner.training.split_loss_weight=abc", "split_loss_weight must be a number, got 'abc'"),
+    ("local", "planner.training.seed=1.5", "seed must be an integer"),
+    ("local", "planner.training.epochs=0", "epochs, batch_size and trainable_layers at least 1"),
+    ("local", "planner.training.lr=-0.1", "lr must not be negative"),
+    ("local", "planner.temperature=0", "temperature must be positive"),
+    # planner=local_context validates its training block with pydantic (planners/local_config.py)
+    ("local_context", "planner.training.split_loss_weight=abc", "split_loss_weight\n  Input should be a valid number"),
+    ("local_context", "planner.training.seed=1.5", "seed\n  Input should be a valid integer"),
+    ("local_context", "planner.training.epochs=0", "epochs\n  Input should be greater than or equal to 1"),
+    ("local_context", "planner.training.trainable_layers=7",
+     "trainable_layers\n  Input should be less than or equal to 6"),
+    ("local_context", "+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
+    ("local_context", "planner.temperature=0", "temperature must be positive"),
 ])
-def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message, compose):
+def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, planner, override, message,
+                                                                        compose):
     from emopose.build import ConfigError, make
 
-    cfg = compose("planner=local", f"planner.cache_dir={tmp_path}", override)
+    cfg = compose(f"planner={planner}", f"planner.cache_dir={tmp_path}", override)
     with pytest.raises(ConfigError, match=re.escape(message)):
         make(cfg.planner, "planner", library=make(cfg.library, "library"))
     assert not list(tmp_path.iterdir())  # nothing trained, nothing cached
