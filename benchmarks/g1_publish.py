@@ -1,6 +1,6 @@
 """Benchmark the G1 backend's publish path against the fake robot on loopback (real DDS 0.10.2).
 
-    python benchmarks/g1_publish.py [--seconds 60] [--messages 5000] [--domain-id N]
+    python benchmarks/g1_publish.py [--seconds 60] [--messages 5000] [--domain-id N] [--arm-law robot]
 
 Prints one JSON object:
   latency: per-message cost of build+CRC+write over --messages back-to-back commands on a DDS
@@ -29,6 +29,8 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+
+from omegaconf import OmegaConf
 
 from emopose.backends.g1 import G1Backend
 from emopose.backends.g1.settings import G1Settings
@@ -114,13 +116,19 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=60.0, help="length of the 50 Hz run")
     parser.add_argument("--messages", type=int, default=5000, help="messages for the latency run")
     parser.add_argument("--domain-id", type=int, default=random.SystemRandom().randint(20, 230))
+    parser.add_argument("--arm-law", default="robot", help="conf/arm_law/<name>.yaml: the gains and feed-forwards sent")
     args = parser.parse_args()
+    law = OmegaConf.load(REPO / "conf" / "arm_law" / f"{args.arm_law}.yaml")
     fake = start_fake(args.domain_id)
     backend = G1Backend(
         domain_id=args.domain_id,
         lowstate_timeout_s=10.0,
         weight_ramp_down_s=1.0,
         release_blend_s=0.5,
+        kp=law.kp,
+        kd=law.kd,
+        velocity_feedforward=law.velocity_feedforward,
+        gravity_compensation=law.gravity_compensation,
     )
     try:
         latency = measure_link(backend.settings, args.messages)
@@ -139,6 +147,7 @@ def main() -> None:
                 "cyclonedds": metadata.version("cyclonedds"),
                 "python": platform.python_version(),
                 "cpus": os.cpu_count(),
+                "arm_law": law.name,
                 "latency": latency,
                 "period_50hz": period,
                 "lowstate_seen": status["lowstate_valid"],
