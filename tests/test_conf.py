@@ -9,7 +9,7 @@ from hydra.utils import instantiate
 from emopose.build import ConfigError, build_run, make
 from emopose.config import CONFIG_DIR
 
-HEAVY_PLANNERS = {"local", "local_context", "sbert_centroids", "annotate"}  # load MiniLM (annotate: via local)
+HEAVY_PLANNERS = {"local", "sbert_centroids", "annotate"}  # load MiniLM (annotate: via local)
 # tour is not in the primary defaults (tour experiments add it); tour files: tests/tour/test_scenario.py
 GROUPS = sorted(p.name for p in CONFIG_DIR.iterdir() if p.is_dir() and p.name not in ("experiment", "tour"))
 

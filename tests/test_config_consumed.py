@@ -23,8 +23,7 @@ from tests.conftest import compose_config
 
 DEFAULTS = {group: option for entry in OmegaConf.load(CONFIG_DIR / "config.yaml").defaults
             if isinstance(entry, DictConfig) for group, option in entry.items()}
-UNBUILDABLE = {("planner", "local"): "trains for ~11 min on first use (tests/planners/test_local.py)",
-               ("planner", "local_context"): "trains on first use (tests/planners/test_local_context.py)",
+UNBUILDABLE = {("planner", "local"): "trains for minutes on first use (tests/planners/test_local.py)",
                ("planner", "annotate"): "its annotator is planner=local (tests/planners/test_annotate.py)"}
 CONSUMED_WITH = {"prompt": ["planner=llm"], "arm_law": ["backend=mujoco"]}  # read by some options of another group
 

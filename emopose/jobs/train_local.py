@@ -19,8 +19,6 @@ from emopose.bench.sequence_metrics import SequencePrediction, item_scores
 from emopose.bench.suites import SequenceItem
 from emopose.jobs.report import markdown_table, write_results
 from emopose.planners.local import LocalPlanner, ScoredUtterance, trigger_span
-from emopose.planners.local_config import TrainingConfig
-from emopose.planners.local_context import LocalContextPlanner
 from emopose.planners.local_data import Example, load_examples
 from emopose.resources import Run
 
@@ -56,7 +54,7 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
         triggers = tuple(example.text[slice(*trigger_span(example.text, scores.analysis, (a.start, a.end)))]
                          for a in acts)
         result = item_scores(item, SequencePrediction(classes, triggers,
-                                                      tuple(planner.variant(a.cls, a.vector) for a in acts)))
+                                                      tuple(planner.variant(a) for a in acts)))
         sequences += 1
         exact += result["exact"]
         anchors += len(item.anchors)
@@ -90,13 +88,10 @@ class TrainLocalJob:
         res = run.resources
         planner = res.planner
         if not isinstance(planner, LocalPlanner):
-            raise ValueError("train_local needs planner=local or planner=local_context")
+            raise ValueError("train_local needs planner=local")
         if self.retrain:
-            if not isinstance(planner, LocalContextPlanner):
-                raise ValueError("job.retrain needs planner=local_context "
-                                 "(for planner=local, delete its cache file)")
             planner.retrain()
-        held_out = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
+        held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
         examples = [e for e in held_out if not e.history]
         scored = [planner.score(e.text) for e in examples]
         configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
@@ -121,9 +116,7 @@ class TrainLocalJob:
                                         for r in rows])
         text = (f"Local planner on the held-out training slice ({rows[0]['singles']} single-act, "
                 f"{rows[0]['sequences']} multi-act, {rows[0]['dialogues']} dialogue items)\n\n{table}")
-        config = planner.model.config
-        results = {"held_out": rows,
-                   "training": config.model_dump() if isinstance(config, TrainingConfig) else vars(config)}
+        results = {"held_out": rows, "training": planner.config.model_dump()}
         write_results(res.run_dir, results, text)
         print(text)
         return results

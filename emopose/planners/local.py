@@ -1,13 +1,20 @@
-"""planner=local: the embedded offline planner (no network): ordered plans from sentence embeddings.
+"""planner=local: the embedded offline planner (no network): ordered plans from one encoder pass.
 
 1. Cut the utterance into candidate segments (planners/segment.py) and run the model once over the
-   utterance (and, with dialogue history, once more over the utterance read after the previous turn).
+   last dialogue turns and the utterance as one input (planners/local_model.py): an elliptical reply
+   ("That one, with the feathers.") is read in context. Unrelated histories precede training items too
+   (planners/local_data.py), so a history that does not bear on the utterance sways neither its classes
+   nor its split.
 2. Choose the split into acts: the best split of a semi-Markov CRF over the segments (act class
    logits plus boundary logits at the chosen boundaries; neighbouring acts differ), trained as one.
-3. Per act: the variant is the class member whose library description is most similar to the act's
-   text (descriptions come from the live library, so a new variant is selectable without retraining);
-   intensity from cues (intensifiers and exclamations up, hedges down); trigger = the words the anchor
-   head marks around its strongest token; reply = the input text (narration mode).
+3. Per act: the variant is the class member whose library description best fits the act's words and
+   meaning (planners/local_variants.py; descriptions come from the live library, so a new variant is
+   selectable without retraining); intensity from cues (intensifiers and exclamations up, hedges down);
+   trigger = the words the anchor head marks around its strongest token; reply = the input text
+   (narration mode).
+
+The model is trained by `+experiment=train_local` or at first use (progress bars on stderr), seeded and
+cached under cache_dir (planners/local_artifact.py).
 """
 
 from __future__ import annotations
@@ -22,7 +29,11 @@ from emopose import CLASSES
 from emopose.library import MotionLibrary
 from emopose.planners import semi_crf
 from emopose.planners.base import PlannerOutput, PlanRequest, timed
-from emopose.planners.local_model import Analysis, TrainingConfig, load_or_train
+from emopose.planners.local_artifact import load_model, train_artifact
+from emopose.planners.local_config import TrainingConfig
+from emopose.planners.local_heads import Analysis
+from emopose.planners.local_inference import LocalInference
+from emopose.planners.local_variants import VariantChooser
 from emopose.planners.segment import Segment, segments
 
 _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|truly|definitely|never|"
@@ -67,7 +78,7 @@ class ScoredUtterance:
     pieces: list[Segment]
     spans: list[tuple[int, int]]  # candidate acts: piece index ranges [i, j)
     logits: np.ndarray  # (spans, classes) unnormalised class scores
-    vectors: np.ndarray  # (spans, D) semantic vectors, for the variant choice
+    vectors: tuple[np.ndarray, ...]  # each (spans, D): what the variant choice reads (planners/local_heads.py)
     boundaries: np.ndarray  # (pieces - 1,) logit that a new act starts before pieces[k + 1]
 
 
@@ -77,7 +88,7 @@ class _Act:
     end: int
     cls: str
     proba: np.ndarray
-    vector: np.ndarray
+    vectors: tuple[np.ndarray, ...]  # each (D,), for the variant choice
 
 
 def softmax(logits: np.ndarray) -> np.ndarray:
@@ -91,21 +102,27 @@ class LocalPlanner:
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
                  training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
                  boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
-                 context_weight: float = 0.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
+                 variant_word_weight: float = 1.0, bf16_inference: bool = True, trace_inference: bool = True) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         self.library = library
         self.train_files = list(train_files)
-        self.model = self._build_model(cache_dir, training or {}, bf16_inference, trace_inference)
+        self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training or {})
+        self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
+        self.variant_word_weight = variant_word_weight
         self.min_words, self.max_records = min_words, max_records
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
-        self.context_weight = context_weight
-        self._variant_vectors: tuple[int, dict[str, tuple[list[str], np.ndarray]]] = (-1, {})
+        self._load(retrain=False)  # first use trains: the train_local job's own call
 
-    def _build_model(self, cache_dir: str, training: dict, bf16_inference: bool, trace_inference: bool):
-        """The trained model (trained first if no cached one matches); planners/local_context.py swaps it."""
-        return load_or_train(self.train_files, cache_dir, TrainingConfig(**training), bf16_inference,
-                             trace_inference, self._catalogue())
+    def _load(self, retrain: bool) -> None:
+        artifact = train_artifact(self.train_files, self.cache_dir, self.config, self._catalogue(), retrain)
+        self.model = LocalInference(load_model(artifact, self.config), self.bf16_inference, self.trace_inference)
+        self.variants = VariantChooser(self.model.model.variant_projections, self.model.describe,
+                                       self.variant_word_weight)
+
+    def retrain(self) -> None:
+        """Train again (replacing the cached artifact) and use the new model."""
+        self._load(retrain=True)
 
     def plan(self, request: PlanRequest) -> PlannerOutput:
         with timed() as clock:
@@ -123,21 +140,16 @@ class LocalPlanner:
         return scored.analysis, self.best_split(scored)[: self.max_records]
 
     def score(self, utterance: str, history: tuple[dict, ...] = ()) -> ScoredUtterance:
-        """Everything the split needs from the model: one forward pass (two with history)."""
+        """Everything the split needs from the model: one forward pass over the dialogue and the utterance."""
+        analysis = self.model.analyse([utterance], [history])[0]
         pieces = segments(utterance) or [Segment(utterance, 0, len(utterance), True)]
         n = len(pieces)
-        previous = f"{history[-1].get('content', '')} " if history else ""
-        analyses = self.model.analyse([utterance] + ([previous + utterance] if history else []))
         spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)
                  if j - i == n or sum(p.words for p in pieces[i:j]) >= self.min_words]
-        logits, vectors = self.model.classify_spans(analyses[0], [(pieces[i].start, pieces[j - 1].end)
-                                                                  for i, j in spans])
-        if history:
-            whole = spans.index((0, n))
-            in_context, _ = self.model.classify_spans(analyses[1], [(0, len(previous) + len(utterance))])
-            logits[whole] = self._with_context(logits[whole], in_context[0])
-        boundaries = self.model.boundary_logits(analyses[0], pieces)
-        return ScoredUtterance(analyses[0], pieces, spans, logits, vectors, boundaries)
+        logits, vectors = self.model.classify_spans(analysis, [(pieces[i].start, pieces[j - 1].end)
+                                                               for i, j in spans])
+        boundaries = self.model.boundary_logits(analysis, pieces)
+        return ScoredUtterance(analysis, pieces, spans, logits, vectors, boundaries)
 
     def best_split(self, scored: ScoredUtterance) -> list[_Act]:
         """The semi-CRF's best split (planners/semi_crf.py): act scores are the class logits / temperature,
@@ -147,17 +159,12 @@ class LocalPlanner:
         openings = self.boundary_weight * scored.boundaries - self.act_cost
         split = semi_crf.best_split(len(pieces), spans, scored.logits / self.temperature, openings)
         return [_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, CLASSES[c],
-                     softmax(scored.logits[k]), scored.vectors[k]) for k, c in split]
-
-    def _with_context(self, own: np.ndarray, in_context: np.ndarray) -> np.ndarray:
-        """The utterance's own class logits plus context_weight times the log-probabilities of the
-        utterance read after the previous dialogue turn: elliptical replies ("That one.") borrow meaning."""
-        return own + self.context_weight * np.log(softmax(in_context))
+                     softmax(scored.logits[k]), tuple(v[k] for v in scored.vectors)) for k, c in split]
 
     def _record(self, act: _Act, analysis: Analysis, utterance: str) -> dict:
         text = utterance[act.start:act.end]
         start, end = trigger_span(utterance, analysis, (act.start, act.end))
-        return {"class": act.cls, "variant": self.variant(act.cls, act.vector),
+        return {"class": act.cls, "variant": self.variant(act),
                 "intensity": intensity_from_cues(text), "trigger": utterance[start:end],
                 "confidence": round(float(act.proba[CLASSES.index(act.cls)]), 3)}
 
@@ -166,21 +173,6 @@ class LocalPlanner:
         return {e.name: (e.cls, f"{e.name.replace('_', ' ')}: {e.description}")
                 for e in self.library.snapshot.entries.values() if e.motion_type == "sequence"}
 
-    def variant(self, cls: str, vector: np.ndarray) -> str | None:
-        """The class member whose description is nearest the act's projected semantic vector."""
-        version, by_class = self._variant_vectors
-        if version != self.library.version:
-            catalogue = self._catalogue()
-            matrix = self._describe([text for _, text in catalogue.values()])
-            names = list(catalogue)
-            by_class = {c: ([n for n in names if catalogue[n][0] == c],
-                            matrix[[i for i, n in enumerate(names) if catalogue[n][0] == c]]) for c in CLASSES}
-            self._variant_vectors = (self.library.version, by_class)
-        names, matrix = by_class.get(cls, ([], None))
-        if not names:
-            return None
-        return names[int(np.argmax(matrix @ self.model.project(vector[None])[0]))]
-
-    def _describe(self, texts: list[str]) -> np.ndarray:
-        """Description vectors in the space variant() compares projected act vectors in."""
-        return self.model.embed(texts)
+    def variant(self, act: _Act) -> str | None:
+        """The motion of the act's class whose description fits it best (planners/local_variants.py)."""
+        return self.variants.choose(self._catalogue, self.library.version, act.cls, act.vectors)

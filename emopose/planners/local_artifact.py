@@ -14,11 +14,11 @@ import logging
 from pathlib import Path
 
 from emopose.planners.local_config import TrainingConfig
-from emopose.planners.local_context_model import ActModel
 from emopose.planners.local_data import load_examples
+from emopose.planners.local_model import ActModel
 
 log = logging.getLogger(__name__)
-ARTIFACT_VERSION = 9
+ARTIFACT_VERSION = 11
 
 
 def artifact_path(paths: list[str], cache_dir: str | Path, config: TrainingConfig) -> Path:

@@ -16,8 +16,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from emopose.planners.local_context_model import ActModel
-from emopose.planners.local_model import Analysis, boundary_scores, pooled, span_scores
+from emopose.planners.local_heads import Analysis, boundary_scores, span_scores, variant_vectors
+from emopose.planners.local_model import ActModel
 from emopose.planners.segment import Segment
 
 log = logging.getLogger(__name__)
@@ -27,7 +27,7 @@ _NAMES = ("input_ids", "token_type_ids", "attention_mask")
 def inference_encoder(modules: list, encode, example: dict, probe: dict, bf16: bool, trace: bool):
     """inputs -> encode(copies of modules, inputs), for inference: the modules are copied, in bfloat16
     where asked and the CPU supports it, traced when asked (example: inputs to trace with; probe: inputs
-    the traced copy must reproduce eager outputs on). Also planner=local's (planners/local_model.py)."""
+    the traced copy must reproduce eager outputs on)."""
     import torch
 
     copies = [copy.deepcopy(m).eval() for m in modules]
@@ -97,32 +97,27 @@ class LocalInference:
         with self._lock, torch.inference_mode():
             tokens = self.model.tokens(texts, histories)
             class_states, semantic = self._encoder(tokens.inputs)
+            words, weights = self.model.words(tokens.inputs), self.model.word_weights(tokens.inputs)
             out = []
             for k, idx in enumerate(tokens.real):
                 states = class_states[k, idx].float()
                 anchor = self.model.anchor_head(states).squeeze(-1).numpy()
-                out.append(Analysis(tokens.starts[k], states, semantic[k, idx].float(), anchor))
+                out.append(Analysis(tokens.starts[k], states, semantic[k, idx].float(), words[k, idx], anchor,
+                                    weights[k, idx]))
         return out
 
     def classify_spans(self, analysis: Analysis,
-                       spans: list[tuple[int, int]]) -> tuple[np.ndarray, np.ndarray]:
+                       spans: list[tuple[int, int]]) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+        """(class logits, variant vectors) of character spans (planners/local_heads.py)."""
         return span_scores(self.model.act_head, self.config.logit_scale, analysis, spans)
 
     def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
         return boundary_scores(self.model.boundary_head, analysis, pieces)
 
-    def project(self, semantic: np.ndarray) -> np.ndarray:
-        """Semantic vectors (acts or descriptions) -> the space the variant choice compares in, normalised."""
-        import torch
-
-        with torch.inference_mode():
-            vectors = torch.from_numpy(np.ascontiguousarray(semantic, dtype=np.float32))
-            out = self.model.variant_projection(vectors)
-            return torch.nn.functional.normalize(out, dim=-1).numpy()
-
-    def embed(self, texts: list[str]) -> np.ndarray:
-        """Normalised semantic sentence embeddings, (N, D)."""
+    def describe(self, texts: list[str]) -> tuple[np.ndarray, ...]:
+        """The variant vectors (semantic, lexical, distinctive), each (N, D), of whole texts (descriptions)."""
+        width = self.model.body.config.hidden_size
         if not texts:
-            return np.zeros((0, self.model.body.config.hidden_size), dtype=np.float32)
-        analyses = self.analyse(texts)
-        return np.stack([pooled(a.semantic_states, [(0, len(a.starts))])[0].numpy() for a in analyses])
+            return tuple(np.zeros((0, width), dtype=np.float32) for _ in range(3))
+        rows = [variant_vectors(a, [(0, len(a.starts))]) for a in self.analyse(texts)]
+        return tuple(np.concatenate(column) for column in zip(*rows))

@@ -1,8 +1,8 @@
 """Training the local planner's model (planners/local_model.py) on examples from planners/local_data.py.
 
 The frozen lower layers run once over every example (their outputs are cached in float16, with each
-annotated act's pooled semantic vector); each epoch then runs only the fine-tuned top layers and the
-heads over the cache, which is what makes first-use training a few minutes on two cores. Matrix
+annotated act's pooled semantic and lexical vectors); each epoch then runs only the fine-tuned top
+layers and the heads over the cache, which is what makes first-use training a few minutes on two cores. Matrix
 products run in bfloat16 (autocast) where the CPU supports it natively; weights and optimiser state
 stay float32; the learning rates warm up and decay linearly when lr_schedule says so. Every pass shows
 a progress bar with ETA on stderr. Losses, summed:
@@ -10,29 +10,31 @@ a progress bar with ETA on stderr. Losses, summed:
 - act classes (cross-entropy over every annotated act, pooled class states);
 - boundaries (binary, at every candidate segment boundary) and the semi-CRF likelihood of the
   annotated split against every other split of the segments (planners/semi_crf.py);
-- anchors (binary per token: inside the annotated trigger phrase);
-- variants: the projected act vector against the projected descriptions of its class's motions. A
-  random share of each class's motions is left out of every batch (their acts skip the loss), so the
-  projection cannot lean on a fixed set of motions and a new library entry competes on equal terms.
+- anchors (binary per token: inside the annotated trigger phrase).
+
+The variant projections read only frozen states, so they are trained after the epochs, on the cached
+act vectors, in seconds (planners/local_variants.py).
 """
 
 from __future__ import annotations
 
+import itertools
 import logging
 import random
 import sys
 
 from emopose import CLASSES
-from emopose.planners.local_context_model import ActModel
 from emopose.planners.local_data import Example
-from emopose.planners.local_model import Analysis, boundary_features, pooled
+from emopose.planners.local_heads import Analysis, boundary_features, pooled
+from emopose.planners.local_model import ActModel
+from emopose.planners.local_variants import AnnotatedAct, fit_variants
 from emopose.planners.semi_crf import log_partition, split_score
 
 log = logging.getLogger(__name__)
 
 
-def describe(model: ActModel, catalogue: dict[str, tuple[str, str]]):
-    """Semantic vectors of the motions' description texts, {name: (D,) tensor}."""
+def describe(model: ActModel, catalogue: dict[str, tuple[str, str]]) -> dict[str, tuple]:
+    """The motions' description texts as {name: (class, semantic (D,), lexical (D,))} tensors."""
     import torch
 
     if not catalogue:
@@ -40,8 +42,12 @@ def describe(model: ActModel, catalogue: dict[str, tuple[str, str]]):
     with torch.no_grad():
         tokens = model.tokens([text for _, text in catalogue.values()])
         semantic = model.sentence(model.lower(tokens.inputs), tokens.inputs["attention_mask"])
-        return {name: pooled(semantic[k, tokens.real[k]], [(0, len(tokens.real[k]))])[0]
-                for k, name in enumerate(catalogue)}
+        words = model.words(tokens.inputs)
+        out = {}
+        for k, (name, (cls, _)) in enumerate(catalogue.items()):
+            whole = [(0, len(tokens.real[k]))]
+            out[name] = (cls, pooled(semantic[k, tokens.real[k]], whole)[0], pooled(words[k, tokens.real[k]], whole)[0])
+        return out
 
 
 def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str, str]] | None = None,
@@ -54,27 +60,27 @@ def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str
     torch.manual_seed(cfg.seed)
     rng = random.Random(cfg.seed)
     catalogue = catalogue or {}
-    members = {c: [n for n, (cls, _) in catalogue.items() if cls == c] for c in CLASSES}
-    described = describe(model, catalogue)
     for p in model.body.parameters():
         p.requires_grad_(False)
     top = model.body.encoder.layer[model.frozen_depth:]
     for p in top.parameters():
         p.requires_grad_(True)
-    # Batches of similar length waste less compute on padding; their order is shuffled each epoch.
-    by_length = sorted(examples, key=lambda e: len(e.text) + 40 * bool(e.history))  # a history adds ~40 chars
+    model.learn_words(sorted({e.text for e in examples}))
+    # Batches of inputs with the same token count (history prefix included) are barely padded (sorting
+    # by the utterance's characters left a third of every batch padding); their order is shuffled each epoch.
+    lengths = model.input_lengths([e.text for e in examples], [e.history for e in examples])
+    by_length = [examples[k] for k in sorted(range(len(examples)), key=lengths.__getitem__)]
     batches = [by_length[k:k + cfg.batch_size] for k in range(0, len(by_length), cfg.batch_size)]
     bf16 = torch.ops.mkldnn._is_mkldnn_bf16_supported()
-    cache = []
+    cache, annotated = [], []
     with torch.no_grad(), torch.autocast("cpu", dtype=torch.bfloat16, enabled=bf16):
         for batch in tqdm(batches, desc="local planner: frozen layers", unit="batch", file=sys.stderr,
                           disable=not progress):
             tokens = model.tokens([e.text for e in batch], [e.history for e in batch])
             lower = model.lower(tokens.inputs)
-            wanted = catalogue and any(e.variants for e in batch)  # the pretrained top: for variant labels
-            semantic = model.sentence(lower, tokens.inputs["attention_mask"]) if wanted else None
-            acts = [act_semantics(semantic, tokens, k, e) for k, e in enumerate(batch)]
-            cache.append((batch, tokens, lower.half(), acts))
+            if catalogue and any(e.variants for e in batch):  # the pretrained top and the words: variants
+                annotated += annotated_acts(model, batch, tokens, lower)
+            cache.append((batch, tokens, lower.half()))
     heads = [q for h in model.heads for q in h.parameters()]
     optimizer = torch.optim.AdamW([{"params": list(top.parameters()), "lr": cfg.lr},
                                    {"params": heads, "lr": cfg.head_lr}], weight_decay=0.01)
@@ -90,11 +96,9 @@ def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str
             total = 0.0
             bar = tqdm(cache, desc=f"local planner: epoch {epoch + 1}/{cfg.epochs}", unit="batch",
                        file=sys.stderr, disable=not progress)
-            for batch, tokens, lower, semantic in bar:
-                left_out = {n for names in members.values()
-                            for n in rng.sample(names, round(cfg.variant_holdout * len(names)))}
+            for batch, tokens, lower in bar:
                 with torch.autocast("cpu", dtype=torch.bfloat16, enabled=bf16):
-                    loss = batch_loss(model, batch, tokens, lower.float(), semantic, members, described, left_out)
+                    loss = batch_loss(model, batch, tokens, lower.float())
                 optimizer.zero_grad()
                 loss.backward()
                 optimizer.step()
@@ -105,6 +109,7 @@ def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str
     finally:
         model.body.set_attn_implementation(attention)
     top.eval()
+    fit_variants(model.variant_projections, annotated, describe(model, catalogue), cfg, progress)
 
 
 def learning_rate_factor(cfg, steps: int):
@@ -115,71 +120,97 @@ def learning_rate_factor(cfg, steps: int):
     return lambda step: min((step + 1) / warmup, max(0.0, (steps - step) / max(1, steps - warmup)))
 
 
-def act_semantics(semantic, tokens, k: int, example: Example):
-    """The example's annotated acts' pooled semantic vectors (acts, D), or None without variant labels."""
-    if semantic is None or not example.variants:
-        return None
-    analysis = Analysis(tokens.starts[k], None, None, None)
-    ranges = [analysis.token_range(a.start, a.end) for a in example.acts]
-    return pooled(semantic[k, tokens.real[k]].float(), ranges)
+def annotated_acts(model: ActModel, batch: list[Example], tokens, lower) -> list[AnnotatedAct]:
+    """The batch's acts with an annotated variant, with their pooled semantic and lexical vectors."""
+    semantic = model.sentence(lower, tokens.inputs["attention_mask"]).float()
+    words = model.words(tokens.inputs)
+    out = []
+    for k, example in enumerate(batch):
+        if not example.variants:
+            continue
+        analysis = Analysis(tokens.starts[k], None, None, None, None)
+        ranges = [analysis.token_range(a.start, a.end) for a in example.acts]
+        vectors = zip(pooled(semantic[k, tokens.real[k]], ranges), pooled(words[k, tokens.real[k]], ranges))
+        out += [AnnotatedAct(act.label, variant, s, w) for act, variant, (s, w) in zip(example.acts, example.variants, vectors)]
+    return out
 
 
-def batch_loss(model: ActModel, batch: list[Example], tokens, lower, semantic: list,
-               members: dict[str, list[str]], described: dict, left_out: set[str]):
+def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
+    """The summed losses of one batch. Every head runs once over the whole batch: the act, span and
+    segment vectors are gathered from one cumulative sum (per-example head calls took half of each step)."""
     import torch
     from torch.nn.functional import binary_cross_entropy_with_logits as bce
-    from torch.nn.functional import cross_entropy, normalize
+    from torch.nn.functional import cross_entropy
 
     cfg = model.config
-    class_states = model.upper(lower, tokens.inputs["attention_mask"])
-    act_vectors, act_labels, openings_all, boundary_labels = [], [], [], []
-    anchor_logits, anchor_labels = [], []
-    variant_losses, split_losses = [], []
-    for k, example in enumerate(batch):
-        states = class_states[k, tokens.real[k]]
-        analysis = Analysis(tokens.starts[k], states, None, None)
-        act_ranges = [analysis.token_range(a.start, a.end) for a in example.acts]
-        act_vectors.append(pooled(states, act_ranges))
-        act_labels += [CLASSES.index(a.label) for a in example.acts]
-        if semantic[k] is not None:
-            projected = normalize(model.variant_projection(semantic[k]), dim=-1)
-            for act, vector, variant in zip(example.acts, projected, example.variants):
-                candidates = [n for n in members.get(act.label, []) if n not in left_out]
-                if variant in candidates and len(candidates) > 1:
-                    described_here = torch.stack([described[n] for n in candidates])
-                    targets = normalize(model.variant_projection(described_here), dim=-1)
-                    variant_losses.append(cross_entropy((targets @ vector * cfg.logit_scale).unsqueeze(0),
-                                                        torch.tensor([candidates.index(variant)])))
-        openings = states.new_zeros(0)
-        if len(example.pieces) > 1:
-            ranges = [analysis.token_range(p.start, p.end) for p in example.pieces]
-            openings = model.boundary_head(boundary_features(states, ranges)).squeeze(-1)
-            openings_all.append(openings)
-            boundary_labels += example.boundaries
-        gold = example.gold_split() if cfg.split_loss_weight else None
-        if gold is not None:
-            split_losses.append(split_nll(model, example, gold, analysis, openings))
-        if example.anchors:
-            anchor_logits.append(model.anchor_head(states).squeeze(-1))
-            anchor_labels += [float(any(a <= s < b for a, b in example.anchors)) for s in tokens.starts[k]]
-    loss = cross_entropy(model.act_head(torch.cat(act_vectors)) * cfg.logit_scale, torch.tensor(act_labels))
-    if openings_all:
-        loss = loss + bce(torch.cat(openings_all), torch.tensor(boundary_labels, dtype=torch.float32))
-    if split_losses:
-        loss = loss + cfg.split_loss_weight * torch.stack(split_losses).mean()
-    if anchor_logits:
-        loss = loss + cfg.anchor_loss_weight * bce(torch.cat(anchor_logits), torch.tensor(anchor_labels))
-    if variant_losses:
-        loss = loss + cfg.variant_loss_weight * torch.stack(variant_losses).mean()
+    class_states = model.upper(lower, tokens.inputs["attention_mask"]).float()
+    pool = BatchPool(class_states, tokens)
+    acts = pool.add([(k, a.start, a.end) for k, e in enumerate(batch) for a in e.acts])
+    act_labels = torch.tensor([CLASSES.index(a.label) for e in batch for a in e.acts])
+    split = [k for k, e in enumerate(batch) if len(e.pieces) > 1]
+    pieces = {k: pool.add([(k, p.start, p.end) for p in batch[k].pieces]) for k in split}
+    gold = {k: e.gold_split() for k, e in enumerate(batch)} if cfg.split_loss_weight else {}
+    gold = {k: g for k, g in gold.items() if g is not None}
+    spans = {k: [(i, j) for i in range(len(batch[k].pieces)) for j in range(i + 1, len(batch[k].pieces) + 1)]
+             for k in gold}
+    span_rows = {k: pool.add([(k, batch[k].pieces[i].start, batch[k].pieces[j - 1].end) for i, j in spans[k]])
+                 for k in gold}
+    vectors = pool.vectors()
+    loss = cross_entropy(model.act_head(vectors[acts]) * cfg.logit_scale, act_labels)
+    openings = vectors.new_zeros(0)
+    if split:
+        left = vectors[[r for k in split for r in pieces[k][:-1]]]
+        right = vectors[[r for k in split for r in pieces[k][1:]]]
+        openings = model.boundary_head(boundary_features(left, right)).squeeze(-1)
+        labels = torch.tensor([b for k in split for b in batch[k].boundaries], dtype=torch.float32)
+        loss = loss + bce(openings, labels)
+    if gold:  # single-segment items too: their one split is a class likelihood of the whole utterance
+        first = dict(zip(split, itertools.accumulate([0] + [len(pieces[k]) - 1 for k in split])))
+        scores = model.act_head(vectors[[r for k in gold for r in span_rows[k]]]) * cfg.logit_scale
+        offsets = dict(zip(gold, itertools.accumulate([0] + [len(spans[k]) for k in gold])))
+        losses = [split_nll(spans[k], scores[offsets[k]:offsets[k] + len(spans[k])], gold[k],
+                            openings[first.get(k, 0):first.get(k, 0) + len(batch[k].pieces) - 1]) for k in gold]
+        loss = loss + cfg.split_loss_weight * torch.stack(losses).mean()
+    anchored = [k for k, e in enumerate(batch) if e.anchors]
+    if anchored:
+        logits = model.anchor_head(class_states).squeeze(-1)
+        positions = [(k, t) for k in anchored for t in tokens.real[k]]
+        labels = [float(any(a <= s < b for a, b in batch[k].anchors)) for k in anchored for s in tokens.starts[k]]
+        rows, cols = zip(*positions)
+        loss = loss + cfg.anchor_loss_weight * bce(logits[list(rows), list(cols)], torch.tensor(labels))
     return loss
 
 
-def split_nll(model: ActModel, example: Example, gold: list[tuple[tuple[int, int], str]], analysis: Analysis,
-              openings):
+class BatchPool:
+    """Normalised means of a batch's states over character spans of its utterances, gathered at once:
+    add() the spans (example index, start, end), then vectors() pools all of them."""
+
+    def __init__(self, states, tokens) -> None:
+        import torch
+
+        self.summed = torch.cat([states.new_zeros(states.shape[0], 1, states.shape[2]), states.cumsum(1)], dim=1)
+        self.analyses = [Analysis(starts, None, None, None, None) for starts in tokens.starts]
+        self.first_position = [real[0] for real in tokens.real]  # the utterance's tokens are contiguous
+        self.ranges: list[tuple[int, int, int]] = []
+
+    def add(self, spans: list[tuple[int, int, int]]) -> list[int]:
+        """Row indices (into vectors()) of the spans' pooled states."""
+        rows = list(range(len(self.ranges), len(self.ranges) + len(spans)))
+        for k, start, end in spans:
+            first, last = self.analyses[k].token_range(start, end)
+            self.ranges.append((k, self.first_position[k] + first, self.first_position[k] + last))
+        return rows
+
+    def vectors(self):
+        import torch
+
+        k, a, b = (torch.tensor(column) for column in zip(*self.ranges))
+        means = (self.summed[k, b] - self.summed[k, a]) / (b - a).unsqueeze(1).to(self.summed.dtype)
+        return torch.nn.functional.normalize(means, dim=-1)
+
+
+def split_nll(spans: list[tuple[int, int]], span_scores, gold: list[tuple[tuple[int, int], str]], openings):
     """-log P(gold split | utterance) under the semi-CRF over every split of its segments."""
-    pieces, n = example.pieces, len(example.pieces)
-    spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)]
-    ranges = [analysis.token_range(pieces[i].start, pieces[j - 1].end) for i, j in spans]
-    span_scores = model.act_head(pooled(analysis.class_states, ranges)) * model.config.logit_scale
     acts = [(spans.index(span), CLASSES.index(label)) for span, label in gold]
+    n = spans[-1][1]
     return log_partition(n, spans, span_scores, openings) - split_score(acts, spans, span_scores, openings)

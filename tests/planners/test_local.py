@@ -4,19 +4,17 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 
 import numpy as np
 import pytest
 
-from emopose.config import PROJECT_ROOT
-from emopose.library import MotionLibrary
 from emopose.planners.base import PlanRequest
 from emopose.planners.local import intensity_from_cues, trigger_span
 from emopose.planners.local_data import multi_act, single_act, synthetic_sequences
-from emopose.planners.local_model import Analysis
+from emopose.planners.local_heads import Analysis
 from emopose.planners.segment import segments
 from emopose.stages.parse import parse_plan
+from tests.planners.local_helpers import configured_local_planner
 
 
 def test_intensity_cues():
@@ -62,7 +60,7 @@ def test_trigger_is_the_marked_run_of_whole_words_around_the_peak():
     peak = [w for _, w in words].index("downstairs")
     logits[peak] = 2.0
     logits[peak - 1] = 0.5  # "is" is marked too; the unmarked "cloakroom" is not
-    analysis = Analysis(starts, None, None, logits)
+    analysis = Analysis(starts, None, None, None, logits)
     start, end = trigger_span(text, analysis, act)
     assert text[start:end] == "is downstairs"
     logits[:] = 1.0  # everything marked: capped at six words
@@ -72,7 +70,7 @@ def test_trigger_is_the_marked_run_of_whole_words_around_the_peak():
     logits[:] = -1.0
     logits[-1] = 3.0  # the peak on the final full stop: the last word carries the trigger
     starts.append(len(text) - 1)
-    analysis = Analysis(starts, None, None, np.append(logits, 5.0))
+    analysis = Analysis(starts, None, None, None, np.append(logits, 5.0))
     start, end = trigger_span(text, analysis, (0, len(text)))
     assert text[start:end] == "left"
 
@@ -87,26 +85,19 @@ def test_train_local_search_is_checked_before_anything_is_built():
         TrainLocalJob(search={"act_cost": -1.0})
 
 
-@pytest.mark.parametrize("planner, override, message", [
-    ("local", "planner.training.split_loss_weight=abc", "split_loss_weight must be a number, got 'abc'"),
-    ("local", "planner.training.seed=1.5", "seed must be an integer"),
-    ("local", "planner.training.epochs=0", "epochs, batch_size and trainable_layers at least 1"),
-    ("local", "planner.training.lr=-0.1", "lr must not be negative"),
-    ("local", "planner.temperature=0", "temperature must be positive"),
-    # planner=local_context validates its training block with pydantic (planners/local_config.py)
-    ("local_context", "planner.training.split_loss_weight=abc", "split_loss_weight\n  Input should be a valid number"),
-    ("local_context", "planner.training.seed=1.5", "seed\n  Input should be a valid integer"),
-    ("local_context", "planner.training.epochs=0", "epochs\n  Input should be greater than or equal to 1"),
-    ("local_context", "planner.training.trainable_layers=7",
-     "trainable_layers\n  Input should be less than or equal to 6"),
-    ("local_context", "+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
-    ("local_context", "planner.temperature=0", "temperature must be positive"),
+@pytest.mark.parametrize("override, message", [  # the training block is validated by pydantic (local_config.py)
+    ("planner.training.split_loss_weight=abc", "split_loss_weight\n  Input should be a valid number"),
+    ("planner.training.seed=1.5", "seed\n  Input should be a valid integer"),
+    ("planner.training.epochs=0", "epochs\n  Input should be greater than or equal to 1"),
+    ("planner.training.lr=-0.1", "lr\n  Input should be greater than or equal to 0"),
+    ("planner.training.trainable_layers=7", "trainable_layers\n  Input should be less than or equal to 6"),
+    ("+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
+    ("planner.temperature=0", "temperature must be positive"),
 ])
-def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, planner, override, message,
-                                                                        compose):
+def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message, compose):
     from emopose.build import ConfigError, make
 
-    cfg = compose(f"planner={planner}", f"planner.cache_dir={tmp_path}", override)
+    cfg = compose("planner=local", f"planner.cache_dir={tmp_path}", override)
     with pytest.raises(ConfigError, match=re.escape(message)):
         make(cfg.planner, "planner", library=make(cfg.library, "library"))
     assert not list(tmp_path.iterdir())  # nothing trained, nothing cached
@@ -123,30 +114,28 @@ def test_segments_keep_spans_and_boundary_strength():
 
 @pytest.fixture(scope="module")
 def planner(tmp_path_factory):
-    """The configured local planner (same training files and cache as the app) on a copy of the library."""
-    from emopose.build import make
-    from tests.conftest import compose_config  # the compose fixture is per test; this one is per module
-
-    folder = tmp_path_factory.mktemp("lib") / "g1"
-    shutil.copytree(PROJECT_ROOT / "library/g1", folder)
-    library = MotionLibrary.from_config(paths=[str(folder)], limits=str(folder / "limits.yaml"),
-                                        write_dir=str(folder))
-    return make(compose_config(["planner=local"]).planner, "planner", library=library)
+    return configured_local_planner(tmp_path_factory.mktemp("lib") / "g1")
 
 
 @pytest.mark.slow
 def test_quality_floor_on_held_out_training_slice(planner):
-    from emopose.jobs.train_local import held_out_metrics
+    from emopose.jobs.train_local import context_metrics, held_out_metrics
     from emopose.planners.local_data import load_examples
 
-    held_out = load_examples(planner.train_files, planner.model.config.holdout_percent, held_out=True)
-    metrics = held_out_metrics(planner, held_out, [planner.score(e.text) for e in held_out])
-    # Measured (seeded training, 2-core machine): 86.0 / 64.5 / 87.2 / 54.6 % over 279 + 228 items.
-    assert metrics["singles"] > 250 and metrics["sequences"] >= 200
-    assert metrics["single_top1"] >= 0.8, metrics
-    assert metrics["sequence_exact"] >= 0.55, metrics
-    assert metrics["anchor_recall"] >= 0.75, metrics
-    assert metrics["exact_variant"] >= 0.45, metrics
+    held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
+    utterances = [e for e in held_out if not e.history]
+    metrics = held_out_metrics(planner, utterances, [planner.score(e.text) for e in utterances])
+    metrics.update(context_metrics(planner, [e for e in held_out if e.history]))
+    # Measured (seeded, `+experiment=train_local`): single top-1 87.8 %, sequence exact 61.8 %, anchor
+    # recall 84.4 %, exact variant 50.1 %, dialogues 87.7 % with history, 72.5 % without. Floors leave
+    # about 3 points for CPU training that is not bit-for-bit repeatable.
+    assert metrics["singles"] > 250 and metrics["sequences"] >= 200 and metrics["dialogues"] >= 150
+    assert metrics["single_top1"] >= 0.84, metrics
+    assert metrics["sequence_exact"] >= 0.58, metrics
+    assert metrics["anchor_recall"] >= 0.81, metrics
+    assert metrics["exact_variant"] >= 0.46, metrics
+    assert metrics["context_with_history"] >= 0.84, metrics
+    assert metrics["context_with_history"] >= metrics["context_without"] + 0.10, metrics
 
 
 @pytest.mark.slow
@@ -168,8 +157,7 @@ def test_blank_utterance_gets_a_plan_without_gestures(planner):
 
 @pytest.mark.slow
 def test_new_variant_is_selectable_without_retraining(planner):
-    # An act about the new motion picks it. The learned projection leans towards annotated motions, so
-    # a mixed utterance ("Hello and welcome, let me salute you...") still gets open_arms.
+    # An act about the new motion picks it (tests/planners/test_local_new_motions.py: five motions).
     utterance = "Welcome aboard, let me give you a proper sailor's salute!"
     before = json.loads(planner.plan(PlanRequest(utterance)).raw)["gestures"][0]
     assert before["class"] == "welcoming"

@@ -7,8 +7,8 @@ import json
 import pytest
 
 from emopose.planners.local_config import TrainingConfig
-from emopose.planners.local_context_model import CONTEXT_CHARS, ActModel, context_prefix
 from emopose.planners.local_data import load_examples
+from emopose.planners.local_model import CONTEXT_CHARS, ActModel, context_prefix
 
 DIALOGUE = ({"role": "user", "content": "Can my son touch the starfish?"},
             {"role": "assistant", "content": "Of course. I could also take him behind the scenes."})
