@@ -54,7 +54,7 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
         triggers = tuple(example.text[slice(*trigger_span(example.text, scores.analysis, (a.start, a.end)))]
                          for a in acts)
         result = item_scores(item, SequencePrediction(classes, triggers,
-                                                      tuple(planner.variant(a) for a in acts)))
+                                                      tuple(a.variant for a in acts)))
         sequences += 1
         exact += result["exact"]
         anchors += len(item.anchors)

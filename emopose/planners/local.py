@@ -88,7 +88,7 @@ class _Act:
     end: int
     cls: str
     proba: np.ndarray
-    vectors: tuple[np.ndarray, ...]  # each (D,), for the variant choice
+    variant: str | None
 
 
 def softmax(logits: np.ndarray) -> np.ndarray:
@@ -102,14 +102,15 @@ class LocalPlanner:
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
                  training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
                  boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
-                 variant_word_weight: float = 1.0, bf16_inference: bool = True, trace_inference: bool = True) -> None:
+                 variant_word_weight: float = 1.0, variant_class_weight: float = 0.0, bf16_inference: bool = True,
+                 trace_inference: bool = True) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         self.library = library
         self.train_files = list(train_files)
         self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training or {})
         self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
-        self.variant_word_weight = variant_word_weight
+        self.variant_word_weight, self.variant_class_weight = variant_word_weight, variant_class_weight
         self.min_words, self.max_records = min_words, max_records
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
         self._load(retrain=False)  # first use trains: the train_local job's own call
@@ -154,17 +155,24 @@ class LocalPlanner:
     def best_split(self, scored: ScoredUtterance) -> list[_Act]:
         """The semi-CRF's best split (planners/semi_crf.py): act scores are the class logits / temperature,
         an act starting inside the utterance adds boundary_weight * its boundary logit - act_cost.
-        The model is trained with (1, 1, 0); the knobs are for the held-out sweep in train_local."""
+        The model is trained with (1, 1, 0); the knobs are for the held-out sweep in train_local.
+        Each act's motion is chosen with its class (planners/local_variants.py), which may move an unsure
+        act to the class of a motion that fits its words clearly better (variant_class_weight)."""
         pieces, spans = scored.pieces, scored.spans
         openings = self.boundary_weight * scored.boundaries - self.act_cost
         split = semi_crf.best_split(len(pieces), spans, scored.logits / self.temperature, openings)
-        return [_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, CLASSES[c],
-                     softmax(scored.logits[k]), tuple(v[k] for v in scored.vectors)) for k, c in split]
+        acts = []
+        for k, c in split:
+            proba = softmax(scored.logits[k])
+            cls, variant = self.variants.choose(self._catalogue, self.library.version, CLASSES[c], proba,
+                                                tuple(v[k] for v in scored.vectors), self.variant_class_weight)
+            acts.append(_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, cls, proba, variant))
+        return acts
 
     def _record(self, act: _Act, analysis: Analysis, utterance: str) -> dict:
         text = utterance[act.start:act.end]
         start, end = trigger_span(utterance, analysis, (act.start, act.end))
-        return {"class": act.cls, "variant": self.variant(act),
+        return {"class": act.cls, "variant": act.variant,
                 "intensity": intensity_from_cues(text), "trigger": utterance[start:end],
                 "confidence": round(float(act.proba[CLASSES.index(act.cls)]), 3)}
 
@@ -172,7 +180,3 @@ class LocalPlanner:
         """Selectable motions of the live library: name -> (class, text its description is matched by)."""
         return {e.name: (e.cls, f"{e.name.replace('_', ' ')}: {e.description}")
                 for e in self.library.snapshot.entries.values() if e.motion_type == "sequence"}
-
-    def variant(self, act: _Act) -> str | None:
-        """The motion of the act's class whose description fits it best (planners/local_variants.py)."""
-        return self.variants.choose(self._catalogue, self.library.version, act.cls, act.vectors)

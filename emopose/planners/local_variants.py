@@ -53,12 +53,18 @@ def similarity(projection, acts, motions):
     return normalize(projection(acts), dim=-1) @ normalize(projection(motions), dim=-1).T
 
 
-def scores(projections, act: tuple, motions: tuple, words_weight: float):
-    """(A, M) variant scores of A acts against M motions; act and motions are (semantic, lexical,
-    distinctive) tensors with normalised rows."""
+def projected(projections, vectors: tuple) -> tuple:
+    """(semantic, lexical, distinctive) row vectors as the score compares them: the first two through
+    their projections, each normalised (torch)."""
+    from torch.nn.functional import normalize
+
     semantic, lexical = projections
-    return (similarity(semantic, act[0], motions[0]) + similarity(lexical, act[1], motions[1])
-            + words_weight * act[2] @ motions[2].T)
+    return normalize(semantic(vectors[0]), dim=-1), normalize(lexical(vectors[1]), dim=-1), vectors[2]
+
+
+def scores(act: tuple, motions: tuple, words_weight: float):
+    """(A, M) variant scores of A acts against M motions, both as projected() gives them."""
+    return act[0] @ motions[0].T + act[1] @ motions[1].T + words_weight * act[2] @ motions[2].T
 
 
 @dataclass
@@ -121,31 +127,41 @@ def fit_variants(projections, acts: list[AnnotatedAct], described: dict[str, tup
 
 
 class VariantChooser:
-    """Inference: the best-scoring motion of a class for an act, description vectors cached per library
+    """Inference: an act's class and motion. The descriptions are read and projected once per library
     version. describe(texts) -> (semantic, lexical, distinctive), each (N, D), normalised numpy arrays."""
 
     def __init__(self, projections, describe, words_weight: float) -> None:
         self.projections, self.describe, self.words_weight = projections, describe, words_weight
-        self._cached: tuple[int, dict] = (-1, {})
+        self._cached: tuple = (-1, [], np.zeros(0, dtype=int), ())
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, str]]], version: int, cls: str,
-               vectors: tuple[np.ndarray, ...]) -> str | None:
-        """catalogue() -> the live library's selectable motions, name -> (class, description text);
-        read again when the library's version changes. vectors: the act's, as describe gives them."""
+               proba: np.ndarray, vectors: tuple[np.ndarray, ...], class_weight: float) -> tuple[str, str | None]:
+        """(class, motion) for an act the split model reads as cls with class probabilities proba: the
+        class c maximising log proba[c] + class_weight * (its best motion's score), and that motion. With
+        class_weight 0 the class stays cls; above, a class the model found less likely wins only when one
+        of its motions fits the act's words clearly better (a new "finger wag" motion for a scolding the
+        model half read as comforting). catalogue() -> the live library's selectable motions, name ->
+        (class, description text), read again when the library's version changes. vectors: the act's,
+        as describe gives them."""
         import torch
 
         if self._cached[0] != version:
             entries = catalogue()
-            names = list(entries)
-            described = self.describe([text for _, text in entries.values()])
-            by_class = {}
-            for c in CLASSES:
-                rows = [k for k, n in enumerate(names) if entries[n][0] == c]
-                by_class[c] = ([names[k] for k in rows], tuple(torch.from_numpy(v[rows]) for v in described))
-            self._cached = (version, by_class)
-        names, motions = self._cached[1].get(cls, ([], ()))
+            with torch.inference_mode():
+                motions = projected(self.projections, tuple(torch.from_numpy(v) for v in
+                                                            self.describe([text for _, text in entries.values()])))
+            classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
+            self._cached = (version, list(entries), classes, motions)
+        _, names, classes, motions = self._cached
         if not names:
-            return None
+            return cls, None
         with torch.inference_mode():
-            act = tuple(torch.from_numpy(v[None]) for v in vectors)
-            return names[int(torch.argmax(scores(self.projections, act, motions, self.words_weight)[0]))]
+            act = projected(self.projections, tuple(torch.from_numpy(v[None]) for v in vectors))
+            row = scores(act, motions, self.words_weight)[0].numpy()
+        allowed = np.log(proba[classes] + 1e-12) + class_weight * row if class_weight else \
+            np.where(classes == CLASSES.index(cls), row, -np.inf)
+        if not np.isfinite(allowed).any():
+            return cls, None
+        # per motion: its class's log-probability plus the weighted fit; the best motion names the class
+        best = int(np.argmax(allowed))
+        return CLASSES[classes[best]], names[best]

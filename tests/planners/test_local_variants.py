@@ -1,0 +1,90 @@
+"""The local planner's variant choice (planners/local_variants.py), on hand-made vectors: no model."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from emopose import CLASSES
+from emopose.planners.local_variants import AnnotatedAct, VariantChooser, fit_variants, new_projections
+
+CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who knows"),
+             "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}
+AXIS = {name: k for k, name in enumerate(CATALOGUE)}  # each motion's description is one axis of a 4-D space
+
+
+def describe(texts: list[str]) -> tuple[np.ndarray, ...]:
+    rows = np.eye(4, dtype=np.float32)[[AXIS[n] for n, (_, t) in CATALOGUE.items() if t in texts]]
+    return rows, rows, rows
+
+
+def act_near(name: str, other: str | None = None, share: float = 0.0) -> tuple[np.ndarray, ...]:
+    vector = np.eye(4, dtype=np.float32)[AXIS[name]] * (1 - share)
+    if other:
+        vector[AXIS[other]] = share
+    vector /= np.linalg.norm(vector)
+    return vector, vector, vector
+
+
+def proba(**by_class: float) -> np.ndarray:
+    return np.array([by_class.get(c, 0.0) for c in CLASSES]) + 1e-3
+
+
+@pytest.fixture
+def chooser():
+    return VariantChooser(new_projections(4), describe, words_weight=1.0)
+
+
+def test_the_best_fitting_motion_of_the_class_is_chosen(chooser):
+    unsure = proba(doubting=0.6, rejecting=0.4)
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("shrug"), 0.0) == ("doubting", "shrug")
+    # without the class weight the class is the split model's, even when another class's motion fits
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("finger_wag"), 0.0)[0] == "doubting"
+
+
+def test_a_clearly_better_motion_may_move_an_unsure_act_but_not_a_sure_one(chooser):
+    scolding = act_near("finger_wag")
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), scolding,
+                          2.0) == ("rejecting", "finger_wag")
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.999), scolding,
+                          2.0) == ("doubting", "chin_stroke")
+    # an act that fits a doubting motion as well as the rejecting one keeps the likelier class
+    even = act_near("chin_stroke", "finger_wag", 0.5)
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
+                          2.0)[0] == "doubting"
+
+
+def test_descriptions_are_read_again_when_the_library_changes(chooser):
+    calls = []
+
+    def catalogue():
+        calls.append(1)
+        return CATALOGUE
+
+    for version in (1, 1, 2):
+        chooser.choose(catalogue, version, "doubting", proba(doubting=1.0), act_near("shrug"), 0.0)
+    assert len(calls) == 2
+
+
+def test_projections_learn_the_annotated_motion():
+    import torch
+
+    torch.manual_seed(0)
+    described = {n: (c, torch.eye(4)[AXIS[n]], torch.eye(4)[AXIS[n]]) for n, (c, _) in CATALOGUE.items()}
+    # acts exactly between two doubting motions, annotated with the second: untrained, the tie goes to the
+    # first; trained, the projections tell them apart
+    between = torch.nn.functional.normalize(torch.eye(4)[AXIS["chin_stroke"]] + torch.eye(4)[AXIS["shrug"]], dim=0)
+    vector = between.numpy()
+    projections = new_projections(4)
+
+    def chosen() -> str | None:
+        chooser = VariantChooser(projections, describe, words_weight=0.0)
+        return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), (vector,) * 3, 0.0)[1]
+
+    assert chosen() == "chin_stroke"
+    acts = [AnnotatedAct("doubting", "shrug", between.clone(), between.clone()) for _ in range(64)]
+    cfg = SimpleNamespace(seed=0, head_lr=0.05, batch_size=16, logit_scale=20.0, variant_holdout=0.0, variant_epochs=20)
+    fit_variants(projections, acts, described, cfg, progress=False)
+    assert chosen() == "shrug"
