@@ -27,7 +27,7 @@ def planner(tmp_path_factory):
 # Measured: picked for 5/5/4/5/5 of the utterances (sailor_salute, thumbs_up, finger_wag, head_scratch,
 # point_down): the target, >= 4 of 5 each, is met. 5/5/2/5/5 with variant_class_weight=0 (the misses
 # were class errors: playful scolding read as comforting), 2/2/1/0/4 by the earlier utterance-only planner.
-# The floors leave two picks in all for CPU training that is not bit-for-bit repeatable.
+# The floors leave two picks in all for training on another CPU (bfloat16 and thread counts differ).
 @pytest.mark.slow
 def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
     rows = [json.loads(line) for line in (NEW / "utterances.jsonl").read_text().splitlines()]
