@@ -7,8 +7,8 @@
    nor its split.
 2. Choose the split into acts: the best split of a semi-Markov CRF over the segments (act class
    logits plus boundary logits at the chosen boundaries; neighbouring acts differ), trained as one.
-3. Per act: the variant is the class member whose library description best fits the act's words and
-   meaning (planners/local_variants.py; descriptions come from the live library, so a new variant is
+3. Per act: the motion whose library description best fits the act's words and meaning, chosen with
+   its class (planners/local_variants.py; descriptions come from the live library, so a new motion is
    selectable without retraining); intensity from cues (intensifiers and exclamations up, hedges down);
    trigger = the words the anchor head marks around its strongest token; reply = the input text
    (narration mode).

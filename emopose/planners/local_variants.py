@@ -17,6 +17,9 @@ learn what in an utterance points at a description, not which motions the data f
 distinctive term keeps a new motion's own words decisive: a motion added by file is scored like a known
 one, without retraining. The projections read only frozen states, so they are trained apart from the
 encoder, in seconds, after its epochs (planners/local_training.py).
+
+The class is chosen with the motion (VariantChooser.choose): log p(class) + class_weight * score, so a
+motion that fits an act's words clearly better can move an act the split model was unsure about.
 """
 
 from __future__ import annotations
