@@ -134,8 +134,9 @@ class LocalPlanner:
 
     def acts(self, utterance: str, history: tuple[dict, ...] = ()) -> tuple[Analysis | None, list[_Act]]:
         """The best split of the utterance into acts (see best_split), at most max_records of them.
-        A blank utterance has no acts (and nothing to analyse)."""
-        if not utterance.strip():
+        A blank utterance (or one of characters the tokenizer drops, such as a zero-width space) has no
+        acts and nothing to analyse."""
+        if not self.model.readable(utterance):
             return None, []
         scored = self.score(utterance, history)
         return scored.analysis, self.best_split(scored)[: self.max_records]
@@ -161,11 +162,14 @@ class LocalPlanner:
         pieces, spans = scored.pieces, scored.spans
         openings = self.boundary_weight * scored.boundaries - self.act_cost
         split = semi_crf.best_split(len(pieces), spans, scored.logits / self.temperature, openings)
-        acts = []
-        for k, c in split:
+        acts: list[_Act] = []
+        for n, (k, c) in enumerate(split):
             proba = softmax(scored.logits[k])
+            neighbours = {acts[-1].cls} if acts else set()  # neighbouring acts keep differing in class
+            neighbours |= {CLASSES[split[n + 1][1]]} if n + 1 < len(split) else set()
             cls, variant = self.variants.choose(self._catalogue, self.library.version, CLASSES[c], proba,
-                                                tuple(v[k] for v in scored.vectors), self.variant_class_weight)
+                                                tuple(v[k] for v in scored.vectors), self.variant_class_weight,
+                                                frozenset(neighbours))
             acts.append(_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, cls, proba, variant))
         return acts
 

@@ -2,7 +2,7 @@
 
 `train_artifact` is the training job: `python -m emopose +experiment=train_local` runs it explicitly
 (retrain=True to replace a cached file), and the planner's first use calls it when its artifact is
-missing. `load_model` only loads. The library's motion descriptions supervise the variant projection
+missing. `load_model` only loads. The library's motion descriptions supervise the variant projections
 but are not part of the key: editing a description does not force a retrain.
 """
 

@@ -6,6 +6,9 @@
   states of the segments on either side; act and boundary logits are also the potentials of the
   semi-Markov CRF over segments (planners/semi_crf.py), which is how the planner splits;
 - anchor head: per token, whether it belongs to the phrase that carries the act (the trigger).
+
+variant_vectors pools the same token ranges of the semantic and lexical states for the variant choice
+(planners/local_variants.py).
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ class Analysis:
     semantic_states: object  # torch (T, D), from the pretrained top layers (sentence similarity)
     lexical_states: object  # torch (T, D), the word embeddings (which words)
     anchor_logits: np.ndarray  # (T,)
-    word_weights: object = None  # torch (T,), how distinctive each word is (planners/local_variants.py)
+    word_weights: object = None  # torch (T,), how distinctive each word is; needed by variant_vectors only
 
     def token_range(self, start: int, end: int) -> tuple[int, int]:
         """Tokens starting inside [start, end); never empty (a span cut off by truncation gets the last)."""

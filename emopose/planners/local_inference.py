@@ -106,6 +106,11 @@ class LocalInference:
                                     weights[k, idx]))
         return out
 
+    def readable(self, text: str) -> bool:
+        """Whether the text has any token (a zero-width space or a control character alone has none)."""
+        with self._lock:  # the fast tokenizer must not be used from two threads at once
+            return bool(self.model.tokenizer.tokenize(text))
+
     def classify_spans(self, analysis: Analysis,
                        spans: list[tuple[int, int]]) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
         """(class logits, variant vectors) of character spans (planners/local_heads.py)."""

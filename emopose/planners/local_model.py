@@ -9,9 +9,9 @@ kept; their character starts are relative to the utterance. One forward pass giv
   (planners/local_heads.py);
 - semantic states: the pretrained sentence encoder's own output (a frozen copy of the top layers run
   over the same lower states; mean-pooled, this is all-MiniLM-L6-v2's sentence embedding);
-- lexical states: the word embeddings. The variant choice (planners/local_variants.py) compares both
-  with the live library's descriptions through two small projections, so a new or edited motion is
-  scored like a known one.
+- lexical states: the word embeddings (weighted by rarity for the distinctive vectors). The variant
+  choice (planners/local_variants.py) compares these with the live library's descriptions, two of them
+  through small trained projections, so a new or edited motion is scored like a known one.
 
 Inference (bf16, traced) is planners/local_inference.py, training planners/local_training.py, the
 cached artifact planners/local_artifact.py.
@@ -152,6 +152,6 @@ class ActModel:
     def load_state(self, state: dict) -> None:
         for key, weights in state["top"].items():
             self.body.encoder.layer[int(key.split(".")[1])].load_state_dict(weights)
-        for head, weights in zip(self.heads, state["heads"]):
+        for head, weights in zip(self.heads, state["heads"], strict=True):
             head.load_state_dict(weights)
         self.word_frequency = state["word_frequency"]

@@ -81,7 +81,7 @@ def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str
             if catalogue and any(e.variants for e in batch):  # the pretrained top and the words: variants
                 annotated += annotated_acts(model, batch, tokens, lower)
             cache.append((batch, tokens, lower.half()))
-    heads = [q for h in model.heads for q in h.parameters()]
+    heads = [q for h in (model.act_head, model.boundary_head, model.anchor_head) for q in h.parameters()]
     optimizer = torch.optim.AdamW([{"params": list(top.parameters()), "lr": cfg.lr},
                                    {"params": heads, "lr": cfg.head_lr}], weight_decay=0.01)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, learning_rate_factor(cfg, cfg.epochs * len(cache)))
@@ -168,7 +168,7 @@ def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
         first = dict(zip(split, itertools.accumulate([0] + [len(pieces[k]) - 1 for k in split])))
         scores = model.act_head(vectors[[r for k in gold for r in span_rows[k]]]) * cfg.logit_scale
         offsets = dict(zip(gold, itertools.accumulate([0] + [len(spans[k]) for k in gold])))
-        losses = [split_nll(spans[k], scores[offsets[k]:offsets[k] + len(spans[k])], gold[k],
+        losses = [split_nll(len(batch[k].pieces), spans[k], scores[offsets[k]:offsets[k] + len(spans[k])], gold[k],
                             openings[first.get(k, 0):first.get(k, 0) + len(batch[k].pieces) - 1]) for k in gold]
         loss = loss + cfg.split_loss_weight * torch.stack(losses).mean()
     anchored = [k for k, e in enumerate(batch) if e.anchors]
@@ -190,7 +190,9 @@ class BatchPool:
 
         self.summed = torch.cat([states.new_zeros(states.shape[0], 1, states.shape[2]), states.cumsum(1)], dim=1)
         self.analyses = [Analysis(starts, None, None, None, None) for starts in tokens.starts]
-        self.first_position = [real[0] for real in tokens.real]  # the utterance's tokens are contiguous
+        self.first_position = [real[0] for real in tokens.real]
+        if any(real != list(range(real[0], real[0] + len(real))) for real in tokens.real):
+            raise ValueError("an utterance's tokens are not contiguous in its input")  # pooling assumes it
         self.ranges: list[tuple[int, int, int]] = []
 
     def add(self, spans: list[tuple[int, int, int]]) -> list[int]:
@@ -209,8 +211,8 @@ class BatchPool:
         return torch.nn.functional.normalize(means, dim=-1)
 
 
-def split_nll(spans: list[tuple[int, int]], span_scores, gold: list[tuple[tuple[int, int], str]], openings):
-    """-log P(gold split | utterance) under the semi-CRF over every split of its segments."""
+def split_nll(n: int, spans: list[tuple[int, int]], span_scores, gold: list[tuple[tuple[int, int], str]],
+              openings):
+    """-log P(gold split | utterance) under the semi-CRF over every split of its n segments."""
     acts = [(spans.index(span), CLASSES.index(label)) for span, label in gold]
-    n = spans[-1][1]
     return log_partition(n, spans, span_scores, openings) - split_score(acts, spans, span_scores, openings)

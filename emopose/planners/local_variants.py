@@ -138,33 +138,38 @@ class VariantChooser:
         self._cached: tuple = (-1, [], np.zeros(0, dtype=int), ())
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, str]]], version: int, cls: str,
-               proba: np.ndarray, vectors: tuple[np.ndarray, ...], class_weight: float) -> tuple[str, str | None]:
+               proba: np.ndarray, vectors: tuple[np.ndarray, ...], class_weight: float,
+               excluded: frozenset[str] = frozenset()) -> tuple[str, str | None]:
         """(class, motion) for an act the split model reads as cls with class probabilities proba: the
         class c maximising log proba[c] + class_weight * (its best motion's score), and that motion. With
-        class_weight 0 the class stays cls; above, a class the model found less likely wins only when one
-        of its motions fits the act's words clearly better (a new "finger wag" motion for a scolding the
-        model half read as comforting). catalogue() -> the live library's selectable motions, name ->
-        (class, description text), read again when the library's version changes. vectors: the act's,
-        as describe gives them."""
+        class_weight 0, or when cls has no motion, the class stays cls; otherwise a class the model found
+        less likely wins only when one of its motions fits the act's words clearly better (a new "finger
+        wag" motion for a scolding the model half read as comforting). Classes in excluded (the
+        neighbouring acts') are never moved to. catalogue() -> the live library's selectable motions,
+        name -> (class, description text), read again when the library's version changes. vectors: the
+        act's, as describe gives them."""
         import torch
 
-        if self._cached[0] != version:
+        cached = self._cached  # one read: another thread may replace it
+        if cached[0] != version:
             entries = catalogue()
             with torch.inference_mode():
                 motions = projected(self.projections, tuple(torch.from_numpy(v) for v in
                                                             self.describe([text for _, text in entries.values()])))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
-            self._cached = (version, list(entries), classes, motions)
-        _, names, classes, motions = self._cached
-        if not names:
+            cached = self._cached = (version, list(entries), classes, motions)
+        _, names, classes, motions = cached
+        own = classes == CLASSES.index(cls)
+        if not own.any():
             return cls, None
         with torch.inference_mode():
             act = projected(self.projections, tuple(torch.from_numpy(v[None]) for v in vectors))
             row = scores(act, motions, self.words_weight)[0].numpy()
-        allowed = np.log(proba[classes] + 1e-12) + class_weight * row if class_weight else \
-            np.where(classes == CLASSES.index(cls), row, -np.inf)
-        if not np.isfinite(allowed).any():
-            return cls, None
-        # per motion: its class's log-probability plus the weighted fit; the best motion names the class
-        best = int(np.argmax(allowed))
+        if class_weight:
+            others = ~own & ~np.isin(classes, [CLASSES.index(c) for c in excluded])
+            # per motion: its class's log-probability plus the weighted fit; the best motion names the class
+            total = np.where(own | others, np.log(proba[classes] + 1e-12) + class_weight * row, -np.inf)
+        else:
+            total = np.where(own, row, -np.inf)
+        best = int(np.argmax(total))
         return CLASSES[classes[best]], names[best]

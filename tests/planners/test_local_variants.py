@@ -56,6 +56,16 @@ def test_a_clearly_better_motion_may_move_an_unsure_act_but_not_a_sure_one(choos
                           2.0)[0] == "doubting"
 
 
+def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser):
+    scolding = act_near("finger_wag")
+    unsure = proba(doubting=0.6, rejecting=0.4)
+    # the split model's class has no motion in the library: it stays, without a motion
+    assert chooser.choose(lambda: CATALOGUE, 1, "neutral", proba(neutral=0.99), scolding, 2.0) == ("neutral", None)
+    # the act next to it is already rejecting: neighbouring acts keep differing in class
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, scolding, 2.0,
+                          frozenset({"rejecting"}))[0] == "doubting"
+
+
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
     calls = []
 
