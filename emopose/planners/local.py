@@ -106,6 +106,9 @@ class LocalPlanner:
                  trace_inference: bool = True) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
+        for name, weight in (("variant_word_weight", variant_word_weight), ("variant_class_weight", variant_class_weight)):
+            if not weight >= 0:
+                raise ValueError(f"planner.{name} must be a number >= 0 (0 turns it off), got {weight!r}")
         self.library = library
         self.train_files = list(train_files)
         self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training or {})

@@ -36,12 +36,17 @@ class Analysis:
     word_weights: object = None  # torch (T,), how distinctive each word is; needed by variant_vectors only
 
     def token_range(self, start: int, end: int) -> tuple[int, int]:
-        """Tokens starting inside [start, end); never empty (a span cut off by truncation gets the last)."""
-        first, last = bisect.bisect_left(self.starts, start), bisect.bisect_left(self.starts, end)
-        if first >= last:
-            first = min(first, len(self.starts) - 1)
-            last = first + 1
-        return first, last
+        return token_range(self.starts, start, end)
+
+
+def token_range(starts: list[int], start: int, end: int) -> tuple[int, int]:
+    """Tokens (by character start) starting inside [start, end); never empty (a span cut off by
+    truncation gets the last)."""
+    first, last = bisect.bisect_left(starts, start), bisect.bisect_left(starts, end)
+    if first >= last:
+        first = min(first, len(starts) - 1)
+        last = first + 1
+    return first, last
 
 
 def pooled(states, ranges: list[tuple[int, int]]):

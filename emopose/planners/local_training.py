@@ -25,7 +25,7 @@ import sys
 
 from emopose import CLASSES
 from emopose.planners.local_data import Example
-from emopose.planners.local_heads import Analysis, boundary_features, pooled
+from emopose.planners.local_heads import boundary_features, pooled, token_range
 from emopose.planners.local_model import ActModel
 from emopose.planners.local_variants import AnnotatedAct, fit_variants
 from emopose.planners.semi_crf import log_partition, split_score
@@ -41,13 +41,17 @@ def describe(model: ActModel, catalogue: dict[str, tuple[str, str]]) -> dict[str
         return {}
     with torch.no_grad():
         tokens = model.tokens([text for _, text in catalogue.values()])
-        semantic = model.sentence(model.lower(tokens.inputs), tokens.inputs["attention_mask"])
-        words = model.words(tokens.inputs)
-        out = {}
-        for k, (name, (cls, _)) in enumerate(catalogue.items()):
-            whole = [(0, len(tokens.real[k]))]
-            out[name] = (cls, pooled(semantic[k, tokens.real[k]], whole)[0], pooled(words[k, tokens.real[k]], whole)[0])
-        return out
+        wholes = [[(0, len(real))] for real in tokens.real]
+        vectors = variant_inputs(model, tokens, model.lower(tokens.inputs), wholes)
+        return {name: (cls, *pairs[0]) for (name, (cls, _)), pairs in zip(catalogue.items(), vectors)}
+
+
+def variant_inputs(model: ActModel, tokens, lower, ranges: list[list[tuple[int, int]]]) -> list[list[tuple]]:
+    """Per text, the (semantic, lexical) vectors of its token ranges: what the variant projections read."""
+    semantic = model.sentence(lower, tokens.inputs["attention_mask"]).float()
+    words = model.words(tokens.inputs)
+    return [list(zip(pooled(semantic[k, tokens.real[k]], r), pooled(words[k, tokens.real[k]], r))) if r else []
+            for k, r in enumerate(ranges)]
 
 
 def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str, str]] | None = None,
@@ -122,17 +126,11 @@ def learning_rate_factor(cfg, steps: int):
 
 def annotated_acts(model: ActModel, batch: list[Example], tokens, lower) -> list[AnnotatedAct]:
     """The batch's acts with an annotated variant, with their pooled semantic and lexical vectors."""
-    semantic = model.sentence(lower, tokens.inputs["attention_mask"]).float()
-    words = model.words(tokens.inputs)
-    out = []
-    for k, example in enumerate(batch):
-        if not example.variants:
-            continue
-        analysis = Analysis(tokens.starts[k], None, None, None, None)
-        ranges = [analysis.token_range(a.start, a.end) for a in example.acts]
-        vectors = zip(pooled(semantic[k, tokens.real[k]], ranges), pooled(words[k, tokens.real[k]], ranges))
-        out += [AnnotatedAct(act.label, variant, s, w) for act, variant, (s, w) in zip(example.acts, example.variants, vectors)]
-    return out
+    ranges = [[token_range(tokens.starts[k], a.start, a.end) for a in e.acts] if e.variants else []
+              for k, e in enumerate(batch)]
+    return [AnnotatedAct(act.label, variant, semantic, lexical)
+            for e, pairs in zip(batch, variant_inputs(model, tokens, lower, ranges))
+            for act, variant, (semantic, lexical) in zip(e.acts, e.variants, pairs)]
 
 
 def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
@@ -189,7 +187,7 @@ class BatchPool:
         import torch
 
         self.summed = torch.cat([states.new_zeros(states.shape[0], 1, states.shape[2]), states.cumsum(1)], dim=1)
-        self.analyses = [Analysis(starts, None, None, None, None) for starts in tokens.starts]
+        self.starts = tokens.starts
         self.first_position = [real[0] for real in tokens.real]
         if any(real != list(range(real[0], real[0] + len(real))) for real in tokens.real):
             raise ValueError("an utterance's tokens are not contiguous in its input")  # pooling assumes it
@@ -199,7 +197,7 @@ class BatchPool:
         """Row indices (into vectors()) of the spans' pooled states."""
         rows = list(range(len(self.ranges), len(self.ranges) + len(spans)))
         for k, start, end in spans:
-            first, last = self.analyses[k].token_range(start, end)
+            first, last = token_range(self.starts[k], start, end)
             self.ranges.append((k, self.first_position[k] + first, self.first_position[k] + last))
         return rows
 

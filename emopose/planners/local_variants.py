@@ -49,20 +49,22 @@ def new_projections(width: int) -> tuple:
     return projections
 
 
-def similarity(projection, acts, motions):
-    """(A, M) cosine similarity of A act vectors and M motion vectors after the projection (torch)."""
+def unit(projection, vectors):
+    """The vectors through the projection, each row normalised (torch)."""
     from torch.nn.functional import normalize
 
-    return normalize(projection(acts), dim=-1) @ normalize(projection(motions), dim=-1).T
+    return normalize(projection(vectors), dim=-1)
+
+
+def similarity(projection, acts, motions):
+    """(A, M) cosine similarity of A act vectors and M motion vectors after the projection (torch)."""
+    return unit(projection, acts) @ unit(projection, motions).T
 
 
 def projected(projections, vectors: tuple) -> tuple:
     """(semantic, lexical, distinctive) row vectors as the score compares them: the first two through
-    their projections, each normalised (torch)."""
-    from torch.nn.functional import normalize
-
-    semantic, lexical = projections
-    return normalize(semantic(vectors[0]), dim=-1), normalize(lexical(vectors[1]), dim=-1), vectors[2]
+    their projections, normalised (torch)."""
+    return unit(projections[0], vectors[0]), unit(projections[1], vectors[1]), vectors[2]
 
 
 def scores(act: tuple, motions: tuple, words_weight: float):

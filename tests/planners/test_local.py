@@ -93,6 +93,7 @@ def test_train_local_search_is_checked_before_anything_is_built():
     ("planner.training.trainable_layers=7", "trainable_layers\n  Input should be less than or equal to 6"),
     ("+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
     ("planner.temperature=0", "temperature must be positive"),
+    ("planner.variant_class_weight=-1", "variant_class_weight must be a number >= 0"),
 ])
 def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message, compose):
     from emopose.build import ConfigError, make
