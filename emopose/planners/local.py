@@ -33,7 +33,7 @@ from emopose.planners.local_artifact import load_model, train_artifact
 from emopose.planners.local_config import TrainingConfig
 from emopose.planners.local_heads import Analysis
 from emopose.planners.local_inference import LocalInference
-from emopose.planners.local_variants import VariantChooser
+from emopose.planners.local_variants import Features, VariantChooser, Weights
 from emopose.planners.segment import Segment, segments
 
 _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|truly|definitely|never|"
@@ -78,7 +78,7 @@ class ScoredUtterance:
     pieces: list[Segment]
     spans: list[tuple[int, int]]  # candidate acts: piece index ranges [i, j)
     logits: np.ndarray  # (spans, classes) unnormalised class scores
-    vectors: tuple[np.ndarray, ...]  # each (spans, D): what the variant choice reads (planners/local_heads.py)
+    features: Features  # one row per span: what the variant choice reads (planners/local_variants.py)
     boundaries: np.ndarray  # (pieces - 1,) logit that a new act starts before pieces[k + 1]
 
 
@@ -102,18 +102,19 @@ class LocalPlanner:
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
                  training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
                  boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
-                 variant_word_weight: float = 1.0, variant_class_weight: float = 0.0, bf16_inference: bool = True,
-                 trace_inference: bool = True) -> None:
+                 variant_word_weight: float = 0.5, variant_shared_weight: float = 1.5, variant_class_weight: float = 0.0,
+                 bf16_inference: bool = True, trace_inference: bool = True) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
-        for name, weight in (("variant_word_weight", variant_word_weight), ("variant_class_weight", variant_class_weight)):
+        for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
+                             ("variant_class_weight", variant_class_weight)):
             if not weight >= 0:
                 raise ValueError(f"planner.{name} must be a number >= 0 (0 turns it off), got {weight!r}")
         self.library = library
         self.train_files = list(train_files)
         self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training or {})
         self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
-        self.variant_word_weight, self.variant_class_weight = variant_word_weight, variant_class_weight
+        self.variant_weights, self.variant_class_weight = Weights(variant_word_weight, variant_shared_weight), variant_class_weight
         self.min_words, self.max_records = min_words, max_records
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
         self._load(retrain=False)  # first use trains: the train_local job's own call
@@ -121,8 +122,7 @@ class LocalPlanner:
     def _load(self, retrain: bool) -> None:
         artifact = train_artifact(self.train_files, self.cache_dir, self.config, self._catalogue(), retrain)
         self.model = LocalInference(load_model(artifact, self.config), self.bf16_inference, self.trace_inference)
-        self.variants = VariantChooser(self.model.model.variant_projections, self.model.describe,
-                                       self.variant_word_weight)
+        self.variants = VariantChooser(self.model.model.variant_projections, self.model.describe, self.variant_weights)
 
     def retrain(self) -> None:
         """Train again (replacing the cached artifact) and use the new model."""
@@ -151,10 +151,10 @@ class LocalPlanner:
         n = len(pieces)
         spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)
                  if j - i == n or sum(p.words for p in pieces[i:j]) >= self.min_words]
-        logits, vectors = self.model.classify_spans(analysis, [(pieces[i].start, pieces[j - 1].end)
-                                                               for i, j in spans])
+        logits, features = self.model.classify_spans(analysis, [(pieces[i].start, pieces[j - 1].end)
+                                                                for i, j in spans])
         boundaries = self.model.boundary_logits(analysis, pieces)
-        return ScoredUtterance(analysis, pieces, spans, logits, vectors, boundaries)
+        return ScoredUtterance(analysis, pieces, spans, logits, features, boundaries)
 
     def best_split(self, scored: ScoredUtterance) -> list[_Act]:
         """The semi-CRF's best split (planners/semi_crf.py): act scores are the class logits / temperature,
@@ -171,7 +171,7 @@ class LocalPlanner:
             neighbours = {acts[-1].cls} if acts else set()  # neighbouring acts keep differing in class
             neighbours |= {CLASSES[split[n + 1][1]]} if n + 1 < len(split) else set()
             cls, variant = self.variants.choose(self._catalogue, self.library.version, CLASSES[c], proba,
-                                                tuple(v[k] for v in scored.vectors), self.variant_class_weight,
+                                                scored.features[k], self.variant_class_weight,
                                                 frozenset(neighbours))
             acts.append(_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, cls, proba, variant))
         return acts

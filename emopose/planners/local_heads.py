@@ -7,8 +7,8 @@
   semi-Markov CRF over segments (planners/semi_crf.py), which is how the planner splits;
 - anchor head: per token, whether it belongs to the phrase that carries the act (the trigger).
 
-variant_vectors pools the same token ranges of the semantic and lexical states for the variant choice
-(planners/local_variants.py).
+variant_features pools the same token ranges of the semantic and lexical states, and lists their
+tokens, for the variant choice (planners/local_variants.py).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from emopose import CLASSES
+from emopose.planners.local_variants import Features
 from emopose.planners.segment import Segment
 
 MAX_TOKENS = 128  # the encoder's input, dialogue prefix included
@@ -33,7 +34,8 @@ class Analysis:
     semantic_states: object  # torch (T, D), from the pretrained top layers (sentence similarity)
     lexical_states: object  # torch (T, D), the word embeddings (which words)
     anchor_logits: np.ndarray  # (T,)
-    word_weights: object = None  # torch (T,), how distinctive each word is; needed by variant_vectors only
+    token_ids: np.ndarray | None = None  # (T,); with word_weights, needed by variant_features only
+    word_weights: object = None  # torch (T,), how distinctive each token is
 
     def token_range(self, start: int, end: int) -> tuple[int, int]:
         return token_range(self.starts, start, end)
@@ -78,26 +80,28 @@ def new_heads(width: int) -> tuple:
 
 
 def span_scores(act_head, logit_scale: float, analysis: Analysis,
-                spans: list[tuple[int, int]]) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
-    """(class logits (S, 8), variant vectors) of character spans of the text. The logits are
+                spans: list[tuple[int, int]]) -> tuple[np.ndarray, Features]:
+    """(class logits (S, 8), variant features) of character spans of the text. The logits are
     unnormalised: the split model compares them across spans, softmax gives class probabilities."""
     import torch
 
     ranges = [analysis.token_range(a, b) for a, b in spans]
     with torch.inference_mode():
         logits = act_head(pooled(analysis.class_states, ranges)) * logit_scale
-        return logits.numpy(), variant_vectors(analysis, ranges)
+        return logits.numpy(), variant_features(analysis, ranges)
 
 
-def variant_vectors(analysis: Analysis, ranges: list[tuple[int, int]]) -> tuple[np.ndarray, ...]:
-    """(semantic, lexical, distinctive), each (len(ranges), D): what the variant choice reads of each
-    token range (planners/local_variants.py); distinctive weights each word by its rarity."""
+def variant_features(analysis: Analysis, ranges: list[tuple[int, int]]) -> Features:
+    """What the variant choice reads of each token range (planners/local_variants.py): the pooled
+    semantic, lexical and distinctive (rarity-weighted word) vectors, and the tokens with their rarity."""
     import torch
 
     with torch.inference_mode():
         distinctive = analysis.lexical_states * analysis.word_weights.unsqueeze(1)
-        return tuple(pooled(states, ranges).numpy()
-                     for states in (analysis.semantic_states, analysis.lexical_states, distinctive))
+        vectors = [pooled(states, ranges).numpy()
+                   for states in (analysis.semantic_states, analysis.lexical_states, distinctive)]
+        weights = analysis.word_weights.numpy()
+    return Features(*vectors, [(analysis.token_ids[a:b], weights[a:b]) for a, b in ranges])
 
 
 def boundary_scores(boundary_head, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:

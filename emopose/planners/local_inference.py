@@ -16,8 +16,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from emopose.planners.local_heads import Analysis, boundary_scores, span_scores, variant_vectors
+from emopose.planners.local_heads import Analysis, boundary_scores, span_scores, variant_features
 from emopose.planners.local_model import ActModel
+from emopose.planners.local_variants import Features
 from emopose.planners.segment import Segment
 
 log = logging.getLogger(__name__)
@@ -103,7 +104,7 @@ class LocalInference:
                 states = class_states[k, idx].float()
                 anchor = self.model.anchor_head(states).squeeze(-1).numpy()
                 out.append(Analysis(tokens.starts[k], states, semantic[k, idx].float(), words[k, idx], anchor,
-                                    weights[k, idx]))
+                                    tokens.inputs["input_ids"][k, idx].numpy(), weights[k, idx]))
         return out
 
     def readable(self, text: str) -> bool:
@@ -111,18 +112,14 @@ class LocalInference:
         with self._lock:  # the fast tokenizer must not be used from two threads at once
             return bool(self.model.tokenizer.tokenize(text))
 
-    def classify_spans(self, analysis: Analysis,
-                       spans: list[tuple[int, int]]) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
-        """(class logits, variant vectors) of character spans (planners/local_heads.py)."""
+    def classify_spans(self, analysis: Analysis, spans: list[tuple[int, int]]) -> tuple[np.ndarray, Features]:
+        """(class logits, variant features) of character spans (planners/local_heads.py)."""
         return span_scores(self.model.act_head, self.config.logit_scale, analysis, spans)
 
     def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
         return boundary_scores(self.model.boundary_head, analysis, pieces)
 
-    def describe(self, texts: list[str]) -> tuple[np.ndarray, ...]:
-        """The variant vectors (semantic, lexical, distinctive), each (N, D), of whole texts (descriptions)."""
-        width = self.model.body.config.hidden_size
-        if not texts:
-            return tuple(np.zeros((0, width), dtype=np.float32) for _ in range(3))
-        rows = [variant_vectors(a, [(0, len(a.starts))]) for a in self.analyse(texts)]
-        return tuple(np.concatenate(column) for column in zip(*rows))
+    def describe(self, texts: list[str]) -> Features:
+        """The variant features of whole texts (descriptions)."""
+        rows = [variant_features(a, [(0, len(a.starts))]) for a in self.analyse(texts)] if texts else []
+        return Features.stacked(rows, self.model.body.config.hidden_size)

@@ -1,22 +1,27 @@
 """The local planner's variant choice: the motion of the act's class whose description fits its words.
 
-An act and every library description are read into three vectors each, mean-pooled over their tokens:
+An act and every library description are read into three vectors each, mean-pooled over their tokens,
+and their tokens with rarity weights (Features):
 
 - semantic: the pretrained sentence encoder's states (all-MiniLM-L6-v2 is trained for similarity, so
   "salute" is near "greeting crew coming aboard" without any motion training data);
 - lexical: the encoder's word embeddings (which words are said);
 - distinctive: the word embeddings weighted by rarity, a / (a + p(word)) with p the word's frequency in
-  the training texts (smooth inverse frequency): "baffled", "thumbs", "floor" count, "I" and "the" do not.
+  the training texts (smooth inverse frequency): "baffled", "thumbs", "floor" count, "I" and "the" do not;
+- words: the token ids with the same rarity weights.
 
 score(act, motion) = cos(Ps a, Ps m) over the semantic vectors + cos(Pl a, Pl m) over the lexical ones
-                     + words_weight * cos(a, m) over the distinctive ones, untrained.
+                     + word_weight * cos(a, m) over the distinctive ones
+                     + shared_weight * (share of the act's rarity weight in words the description also uses).
 
 Ps and Pl start as the identity and are trained on the annotated variants of the training split, each
 on its own similarity, with a random share of each class's motions left out of every batch, so they
-learn what in an utterance points at a description, not which motions the data favours. The untrained
-distinctive term keeps a new motion's own words decisive: a motion added by file is scored like a known
-one, without retraining. The projections read only frozen states, so they are trained apart from the
-encoder, in seconds, after its epochs (planners/local_training.py).
+learn what in an utterance points at a description, not which motions the data favours. The two
+untrained terms keep a new motion's own words decisive: a motion added by file is scored like a known
+one, without retraining. The shared-word term counts only words both texts say, so it adds nothing for
+descriptions that merely sound alike (the averaged distinctive vectors do; leaning on the shared words,
+known motions lose fewer acts to new ones). The projections read only frozen states, so they are
+trained apart from the encoder, in seconds, after its epochs (planners/local_training.py).
 
 The class is chosen with the motion (VariantChooser.choose): log p(class) + class_weight * score, so a
 motion that fits an act's words clearly better can move an act the split model was unsure about.
@@ -27,7 +32,7 @@ from __future__ import annotations
 import random
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -61,15 +66,55 @@ def similarity(projection, acts, motions):
     return unit(projection, acts) @ unit(projection, motions).T
 
 
-def projected(projections, vectors: tuple) -> tuple:
-    """(semantic, lexical, distinctive) row vectors as the score compares them: the first two through
-    their projections, normalised (torch)."""
-    return unit(projections[0], vectors[0]), unit(projections[1], vectors[1]), vectors[2]
+@dataclass
+class Features:
+    """What the variant score reads of N texts (acts or descriptions)."""
+
+    semantic: np.ndarray  # (N, D), normalised
+    lexical: np.ndarray  # (N, D), normalised
+    distinctive: np.ndarray  # (N, D), normalised
+    words: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # per text: (token ids, rarity weights)
+
+    def __getitem__(self, k: int) -> Features:
+        return Features(self.semantic[k:k + 1], self.lexical[k:k + 1], self.distinctive[k:k + 1], [self.words[k]])
+
+    @classmethod
+    def stacked(cls, parts: list[Features], width: int) -> Features:
+        if not parts:
+            return cls(*(np.zeros((0, width), dtype=np.float32) for _ in range(3)))
+        return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in ("semantic", "lexical", "distinctive")),
+                   [w for p in parts for w in p.words])
 
 
-def scores(act: tuple, motions: tuple, words_weight: float):
+@dataclass
+class Weights:
+    """How much the untrained terms count in the variant score (conf/planner/local.yaml)."""
+
+    word: float  # the distinctive vectors' cosine
+    shared: float  # the share of the act's rarity weight in words the description also uses
+
+
+def projected(projections, features: Features) -> tuple:
+    """(semantic, lexical, distinctive, words) as the score compares them: the first two through their
+    projections, normalised (torch)."""
+    import torch
+
+    return (unit(projections[0], torch.from_numpy(features.semantic)),
+            unit(projections[1], torch.from_numpy(features.lexical)),
+            torch.from_numpy(features.distinctive), features.words)
+
+
+def shared_words(words: tuple[np.ndarray, np.ndarray], motions: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """(M,): per motion, the share of the act's rarity weight carried by tokens its description also has."""
+    ids, weights = words
+    return np.array([weights[np.isin(ids, motion_ids)].sum() for motion_ids, _ in motions]) / max(weights.sum(), 1e-9)
+
+
+def scores(act: tuple, motions: tuple, weights: Weights) -> np.ndarray:
     """(A, M) variant scores of A acts against M motions, both as projected() gives them."""
-    return act[0] @ motions[0].T + act[1] @ motions[1].T + words_weight * act[2] @ motions[2].T
+    dense = act[0] @ motions[0].T + act[1] @ motions[1].T + weights.word * act[2] @ motions[2].T
+    shared = np.stack([shared_words(words, motions[3]) for words in act[3]]) if motions[3] else 0.0
+    return dense.numpy() + weights.shared * shared
 
 
 @dataclass
@@ -133,14 +178,14 @@ def fit_variants(projections, acts: list[AnnotatedAct], described: dict[str, tup
 
 class VariantChooser:
     """Inference: an act's class and motion. The descriptions are read and projected once per library
-    version. describe(texts) -> (semantic, lexical, distinctive), each (N, D), normalised numpy arrays."""
+    version. describe(texts) -> their Features."""
 
-    def __init__(self, projections, describe, words_weight: float) -> None:
-        self.projections, self.describe, self.words_weight = projections, describe, words_weight
+    def __init__(self, projections, describe: Callable[[list[str]], Features], weights: Weights) -> None:
+        self.projections, self.describe, self.weights = projections, describe, weights
         self._cached: tuple = (-1, [], np.zeros(0, dtype=int), ())
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, str]]], version: int, cls: str,
-               proba: np.ndarray, vectors: tuple[np.ndarray, ...], class_weight: float,
+               proba: np.ndarray, act: Features, class_weight: float,
                excluded: frozenset[str] = frozenset()) -> tuple[str, str | None]:
         """(class, motion) for an act the split model reads as cls with class probabilities proba: the
         class c maximising log proba[c] + class_weight * (its best motion's score), and that motion. With
@@ -148,16 +193,15 @@ class VariantChooser:
         less likely wins only when one of its motions fits the act's words clearly better (a new "finger
         wag" motion for a scolding the model half read as comforting). Classes in excluded (the
         neighbouring acts') are never moved to. catalogue() -> the live library's selectable motions,
-        name -> (class, description text), read again when the library's version changes. vectors: the
-        act's, as describe gives them."""
+        name -> (class, description text), read again when the library's version changes. act: the act's
+        Features (one row)."""
         import torch
 
         cached = self._cached  # one read: another thread may replace it
         if cached[0] != version:
             entries = catalogue()
             with torch.inference_mode():
-                motions = projected(self.projections, tuple(torch.from_numpy(v) for v in
-                                                            self.describe([text for _, text in entries.values()])))
+                motions = projected(self.projections, self.describe([text for _, text in entries.values()]))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
             cached = self._cached = (version, list(entries), classes, motions)
         _, names, classes, motions = cached
@@ -165,8 +209,7 @@ class VariantChooser:
         if not own.any():
             return cls, None
         with torch.inference_mode():
-            act = projected(self.projections, tuple(torch.from_numpy(v[None]) for v in vectors))
-            row = scores(act, motions, self.words_weight)[0].numpy()
+            row = scores(projected(self.projections, act), motions, self.weights)[0]
         if class_weight:
             others = ~own & ~np.isin(classes, [CLASSES.index(c) for c in excluded])
             # per motion: its class's log-probability plus the weighted fit; the best motion names the class

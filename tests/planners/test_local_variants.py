@@ -8,24 +8,33 @@ import numpy as np
 import pytest
 
 from emopose import CLASSES
-from emopose.planners.local_variants import AnnotatedAct, VariantChooser, fit_variants, new_projections
+from emopose.planners.local_variants import (
+    AnnotatedAct,
+    Features,
+    VariantChooser,
+    Weights,
+    fit_variants,
+    new_projections,
+)
 
 CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who knows"),
              "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}
 AXIS = {name: k for k, name in enumerate(CATALOGUE)}  # each motion's description is one axis of a 4-D space
+NO_WORDS = (np.zeros(0, dtype=int), np.zeros(0, dtype=np.float32))
 
 
-def describe(texts: list[str]) -> tuple[np.ndarray, ...]:
-    rows = np.eye(4, dtype=np.float32)[[AXIS[n] for n, (_, t) in CATALOGUE.items() if t in texts]]
-    return rows, rows, rows
+def describe(texts: list[str], words: dict[str, tuple] | None = None) -> Features:
+    names = [n for n, (_, t) in CATALOGUE.items() if t in texts]
+    rows = np.eye(4, dtype=np.float32)[[AXIS[n] for n in names]]
+    return Features(rows, rows, rows, [(words or {}).get(n, NO_WORDS) for n in names])
 
 
-def act_near(name: str, other: str | None = None, share: float = 0.0) -> tuple[np.ndarray, ...]:
+def act_near(name: str, other: str | None = None, share: float = 0.0, words: tuple = NO_WORDS) -> Features:
     vector = np.eye(4, dtype=np.float32)[AXIS[name]] * (1 - share)
     if other:
         vector[AXIS[other]] = share
-    vector /= np.linalg.norm(vector)
-    return vector, vector, vector
+    vector = vector[None] / np.linalg.norm(vector)
+    return Features(vector, vector, vector, [words])
 
 
 def proba(**by_class: float) -> np.ndarray:
@@ -34,7 +43,7 @@ def proba(**by_class: float) -> np.ndarray:
 
 @pytest.fixture
 def chooser():
-    return VariantChooser(new_projections(4), describe, words_weight=1.0)
+    return VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0))
 
 
 def test_the_best_fitting_motion_of_the_class_is_chosen(chooser):
@@ -66,6 +75,18 @@ def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser
                           frozenset({"rejecting"}))[0] == "doubting"
 
 
+def test_a_rare_word_the_description_also_says_decides_between_motions():
+    # token ids: 7 "naughty" (rare), 1 "the" (frequent); only finger_wag's description says "naughty"
+    words = {"finger_wag": (np.array([7, 1]), np.array([0.9, 0.01])), "palm_stop": (np.array([1]), np.array([0.01]))}
+    chooser = VariantChooser(new_projections(4), lambda texts: describe(texts, words), Weights(word=0.0, shared=1.0))
+    # the vectors lean to palm_stop; the shared rare word outweighs them
+    naughty = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 7]), np.array([0.01, 0.9])))
+    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, 0.0)[1] == "finger_wag"
+    # sharing only a frequent word carries no weight against the vectors
+    plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5]), np.array([0.01, 0.9])))
+    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, 0.0)[1] == "palm_stop"
+
+
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
     calls = []
 
@@ -90,8 +111,9 @@ def test_projections_learn_the_annotated_motion():
     projections = new_projections(4)
 
     def chosen() -> str | None:
-        chooser = VariantChooser(projections, describe, words_weight=0.0)
-        return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), (vector,) * 3, 0.0)[1]
+        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0))
+        act = Features(vector[None], vector[None], vector[None], [NO_WORDS])
+        return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), act, 0.0)[1]
 
     assert chosen() == "chin_stroke"
     acts = [AnnotatedAct("doubting", "shrug", between.clone(), between.clone()) for _ in range(64)]
