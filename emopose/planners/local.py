@@ -2,9 +2,10 @@
 
 1. Cut the utterance into candidate segments (planners/segment.py) and run the model once over the
    last dialogue turns and the utterance as one input (planners/local_model.py): an elliptical reply
-   ("That one, with the feathers.") is read in context. Unrelated histories precede training items too
-   (planners/local_data.py), so a history that does not bear on the utterance sways neither its classes
-   nor its split.
+   ("That one, with the feathers.") is read in context. A history the relevance head finds unrelated
+   to the utterance is dropped and the utterance read alone (a second pass), so a change of topic
+   plans as if the dialogue had just begun; unrelated histories precede training items too
+   (planners/local_data.py), which keeps the classes steady where the head errs.
 2. Choose the split into acts: the best split of a semi-Markov CRF over the segments (act class
    logits plus boundary logits at the chosen boundaries; neighbouring acts differ), trained as one.
 3. Per act: the motion whose library description best fits the act's words and meaning, chosen with
@@ -145,8 +146,11 @@ class LocalPlanner:
         return scored.analysis, self.best_split(scored)[: self.max_records]
 
     def score(self, utterance: str, history: tuple[dict, ...] = ()) -> ScoredUtterance:
-        """Everything the split needs from the model: one forward pass over the dialogue and the utterance."""
+        """Everything the split needs from the model: one forward pass over the dialogue and the utterance
+        (two when the history turns out not to bear on it: the utterance is then read alone)."""
         analysis = self.model.analyse([utterance], [history])[0]
+        if analysis.relevance_logit is not None and analysis.relevance_logit < 0:
+            analysis = self.model.analyse([utterance])[0]
         pieces = segments(utterance) or [Segment(utterance, 0, len(utterance), True)]
         n = len(pieces)
         spans = [(i, j) for i in range(n) for j in range(i + 1, n + 1)

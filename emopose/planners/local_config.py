@@ -30,4 +30,5 @@ class TrainingConfig(BaseModel):
     variant_epochs: int = Field(5, ge=0)  # the variant projections' own passes over the annotated acts
     variant_holdout: float = Field(0.3, ge=0, lt=1)  # share of a class's motions left out of each batch
     split_loss_weight: float = Field(1.0, ge=0)  # the semi-CRF likelihood of the annotated split
+    relevance_loss_weight: float = Field(1.0, ge=0)  # whether a history bears on the utterance (distractors: no)
     seed: int = 0

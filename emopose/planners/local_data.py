@@ -12,8 +12,9 @@ the planner can choose at run time:
   sequences alone hold;
 - a dialogue item (train/context/) is one act over its final utterance, read after its history;
 - distractors give training items (single- and multi-act, synthetic too) the history of an unrelated
-  dialogue, labels unchanged, so the model learns that a history which does not bear on the utterance
-  must sway neither its classes nor its split.
+  dialogue, labels unchanged and marked unrelated, so the model learns that a history which does not
+  bear on the utterance must sway neither its classes nor its split, and to tell such a history from
+  one that does (the relevance head; a dialogue item's own history bears on it).
 
 Items whose id hashes into the held-out bucket never enter training (the quality check scores them).
 """
@@ -46,6 +47,7 @@ class Example:
     anchors: list[tuple[int, int]] = field(default_factory=list)  # empty: no anchor supervision
     variants: list[str] = field(default_factory=list)  # annotated motion per act; empty: none
     history: tuple[dict, ...] = ()  # dialogue turns before the text (spans are in the text alone)
+    history_bears: bool = True  # False for a distractor: the history is another dialogue's
 
     @property
     def boundaries(self) -> list[int]:
@@ -162,7 +164,7 @@ def context_distractors(items: list[Example], dialogues: list[Example], count: i
     rng = random.Random(seed)
     if not items or not dialogues:
         return []
-    return [replace(item, id=f"distractor-{n}", history=rng.choice(dialogues).history)
+    return [replace(item, id=f"distractor-{n}", history=rng.choice(dialogues).history, history_bears=False)
             for n, item in enumerate(rng.choices(items, k=count))]
 
 

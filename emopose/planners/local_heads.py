@@ -5,7 +5,10 @@
 - boundary head: whether a new communicative act starts at a candidate segment boundary, from the
   states of the segments on either side; act and boundary logits are also the potentials of the
   semi-Markov CRF over segments (planners/semi_crf.py), which is how the planner splits;
-- anchor head: per token, whether it belongs to the phrase that carries the act (the trigger).
+- anchor head: per token, whether it belongs to the phrase that carries the act (the trigger);
+- relevance head: whether the dialogue history read before the utterance bears on it, from the
+  [CLS] state, which attends to both (BERT's sentence-pair head; a history that does not bear on the
+  utterance is dropped: planners/local.py).
 
 variant_features pools the same token ranges of the semantic and lexical states, and lists their
 tokens, for the variant choice (planners/local_variants.py).
@@ -34,6 +37,7 @@ class Analysis:
     semantic_states: object  # torch (T, D), from the pretrained top layers (sentence similarity)
     lexical_states: object  # torch (T, D), the word embeddings (which words)
     anchor_logits: np.ndarray  # (T,)
+    relevance_logit: float | None = None  # whether the history bears on the text (None: read without one)
     token_ids: np.ndarray | None = None  # (T,); with word_weights, needed by variant_features only
     word_weights: object = None  # torch (T,), how distinctive each token is
 
@@ -70,13 +74,14 @@ def boundary_features(left, right):
 
 
 def new_heads(width: int) -> tuple:
-    """(act head, boundary head, anchor head), freshly initialised (seed first)."""
+    """(act head, boundary head, anchor head, relevance head), freshly initialised (seed first)."""
     import torch
 
     act = torch.nn.Linear(width, len(CLASSES))  # created in this order: the seeded initialisation depends on it
     boundary = torch.nn.Sequential(torch.nn.Linear(4 * width, 64), torch.nn.ReLU(), torch.nn.Linear(64, 1))
     anchor = torch.nn.Linear(width, 1)
-    return act, boundary, anchor
+    relevance = torch.nn.Linear(width, 1)
+    return act, boundary, anchor, relevance
 
 
 def span_scores(act_head, logit_scale: float, analysis: Analysis,

@@ -2,7 +2,8 @@
 
 The encoder reads the dialogue and the utterance as one input: the last turns with role markers
 ("guide: ... visitor: ... [SEP] utterance"), so every utterance token attends to the history and an
-elliptical reply ("That one, with the feathers.") is read in context. Only the utterance's tokens are
+elliptical reply ("That one, with the feathers.") is read in context; a relevance head tells whether
+the history bears on the utterance at all. Only the utterance's tokens are
 kept; their character starts are relative to the utterance. One forward pass gives three states per token:
 
 - class states from the fine-tuned top layers, read by the act, boundary and anchor heads
@@ -76,13 +77,13 @@ class ActModel:
         self.sentence_top = copy.deepcopy(self.body.encoder.layer[self.frozen_depth:]).requires_grad_(False)
         width = self.body.config.hidden_size
         torch.manual_seed(config.seed)
-        self.act_head, self.boundary_head, self.anchor_head = new_heads(width)
+        self.act_head, self.boundary_head, self.anchor_head, self.relevance_head = new_heads(width)
         self.variant_projections = new_projections(width)  # (semantic, lexical)
         self.word_frequency = torch.zeros(self.body.config.vocab_size)  # in the training texts (learn_words)
 
     @property
     def heads(self) -> list:
-        return [self.act_head, self.boundary_head, self.anchor_head, *self.variant_projections]
+        return [self.act_head, self.boundary_head, self.anchor_head, self.relevance_head, *self.variant_projections]
 
     @property
     def frozen_depth(self) -> int:

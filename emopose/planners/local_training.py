@@ -10,7 +10,8 @@ a progress bar with ETA on stderr. Losses, summed:
 - act classes (cross-entropy over every annotated act, pooled class states);
 - boundaries (binary, at every candidate segment boundary) and the semi-CRF likelihood of the
   annotated split against every other split of the segments (planners/semi_crf.py);
-- anchors (binary per token: inside the annotated trigger phrase).
+- anchors (binary per token: inside the annotated trigger phrase);
+- relevance (binary per item read after a history: its own dialogue's, or a distractor's unrelated one).
 
 The variant projections read only frozen states, so they are trained after the epochs, on the cached
 act vectors, in seconds (planners/local_variants.py).
@@ -85,7 +86,8 @@ def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str
             if catalogue and any(e.variants for e in batch):  # the pretrained top and the words: variants
                 annotated += annotated_acts(model, batch, tokens, lower)
             cache.append((batch, tokens, lower.half()))
-    heads = [q for h in (model.act_head, model.boundary_head, model.anchor_head) for q in h.parameters()]
+    heads = [q for h in (model.act_head, model.boundary_head, model.anchor_head, model.relevance_head)
+             for q in h.parameters()]
     optimizer = torch.optim.AdamW([{"params": list(top.parameters()), "lr": cfg.lr},
                                    {"params": heads, "lr": cfg.head_lr}], weight_decay=0.01)
     scheduler = torch.optim.lr_scheduler.LambdaLR(optimizer, learning_rate_factor(cfg, cfg.epochs * len(cache)))
@@ -155,6 +157,11 @@ def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
                  for k in gold}
     vectors = pool.vectors()
     loss = cross_entropy(model.act_head(vectors[acts]) * cfg.logit_scale, act_labels)
+    after_history = [k for k, e in enumerate(batch) if e.history]
+    if after_history and cfg.relevance_loss_weight:  # read from [CLS], which attends to history and utterance
+        bears = torch.tensor([float(batch[k].history_bears) for k in after_history])
+        logits = model.relevance_head(class_states[after_history, 0]).squeeze(-1)
+        loss = loss + cfg.relevance_loss_weight * bce(logits, bears)
     openings = vectors.new_zeros(0)
     if split:
         left = vectors[[r for k in split for r in pieces[k][:-1]]]

@@ -128,15 +128,15 @@ def test_quality_floor_on_held_out_training_slice(planner):
     utterances = [e for e in held_out if not e.history]
     metrics = held_out_metrics(planner, utterances, [planner.score(e.text) for e in utterances])
     metrics.update(context_metrics(planner, [e for e in held_out if e.history]))
-    # Measured (seeded, `+experiment=train_local`): single top-1 87.1 %, sequence exact 62.3 %, anchor
-    # recall 84.4 %, exact variant 50.3 %, dialogues 86.3 % with history, 72.5 % without. Floors leave
+    # Measured (seeded, `+experiment=train_local`): single top-1 87.1 %, sequence exact 61.0 %, anchor
+    # recall 85.2 %, exact variant 52.4 %, dialogues 85.8 % with history, 72.0 % without. Floors leave
     # about 3 points for training on another CPU (bfloat16 support and thread counts change the sums).
     assert metrics["singles"] > 250 and metrics["sequences"] >= 200 and metrics["dialogues"] >= 150
     assert metrics["single_top1"] >= 0.84, metrics
     assert metrics["sequence_exact"] >= 0.58, metrics
     assert metrics["anchor_recall"] >= 0.81, metrics
-    assert metrics["exact_variant"] >= 0.46, metrics
-    assert metrics["context_with_history"] >= 0.84, metrics
+    assert metrics["exact_variant"] >= 0.49, metrics
+    assert metrics["context_with_history"] >= 0.83, metrics
     assert metrics["context_with_history"] >= metrics["context_without"] + 0.10, metrics
 
 

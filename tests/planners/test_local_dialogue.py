@@ -27,25 +27,51 @@ def test_an_elliptical_reply_is_read_in_its_dialogue(planner):
     assert first_class("So you found the exhibit boring, then?") == "rejecting"
 
 
-@pytest.mark.slow
-def test_an_unrelated_history_barely_moves_held_out_items(planner):
-    """Held-out single- and multi-act training items read after the history of a held-out dialogue that
-    has nothing to do with them keep their classes and split. Measured (seeded): 87.8 % -> 82.1 % of the
-    singles and 61.8 % -> 59.2 % of the multi-act items exact (with 800 unrelated histories in training
-    instead of 1,200: 87.1 -> 79.6 and 64.0 -> 59.2); a model trained with single-act distractors only
-    dropped the multi-act items from 62.7 % to 29.8 % when it read them in context."""
+def unrelated_histories(planner):
+    """Held-out items without history, each with the history of a held-out dialogue (seeded draw)."""
     import random
 
     from emopose.planners.local_data import load_examples
 
     held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
     histories = [e.history for e in held_out if e.history]
-    items = [e for e in held_out if not e.history]
     rng = random.Random(0)
+    return [(e, rng.choice(histories)) for e in held_out if not e.history], [e for e in held_out if e.history]
 
-    def exact(history_of) -> float:
-        return sum(tuple(a.cls for a in planner.acts(e.text, history_of(e))[1])
-                   == tuple(a.label for a in e.acts) for e in items) / len(items)
 
-    alone, after = exact(lambda e: ()), exact(lambda e: rng.choice(histories))
-    assert after >= alone - 0.05, (alone, after)
+@pytest.mark.slow
+def test_an_unrelated_history_barely_moves_held_out_items(planner):
+    """Held-out single- and multi-act training items read after the history of a held-out dialogue that
+    has nothing to do with them keep their classes and split. Measured (seeded): singles 86.7 % alone,
+    83.5 % after (82.1 % with the history always read), multi-act items 61.0 % either way (58.8 %); before
+    the relevance head 87.1 -> 81.4 and 62.7 -> 61.0; a model trained with single-act distractors only
+    dropped the multi-act items from 62.7 % to 29.8 % when it read them in context."""
+    items, _ = unrelated_histories(planner)
+
+    def exact(with_history: bool) -> float:
+        return sum(tuple(a.cls for a in planner.acts(e.text, history if with_history else ())[1])
+                   == tuple(a.label for a in e.acts) for e, history in items) / len(items)
+
+    alone, after = exact(False), exact(True)
+    assert after >= alone - 0.03, (alone, after)
+
+
+@pytest.mark.slow
+def test_a_history_that_does_not_bear_on_the_utterance_is_dropped(planner):
+    """The relevance head tells a dialogue's own history from another dialogue's (measured: 92.9 % of the
+    held-out dialogues' own histories judged relevant, 17.0 % of unrelated ones), and the planner reads
+    the utterance alone when it judges the history unrelated."""
+    items, dialogues = unrelated_histories(planner)
+    model = planner.model
+
+    def relevant(text, history) -> bool:
+        return model.analyse([text], [history])[0].relevance_logit >= 0
+
+    own = sum(relevant(e.text, e.history) for e in dialogues) / len(dialogues)
+    judged = [(e, history, relevant(e.text, history)) for e, history in items[:120]]
+    assert own >= 0.85 and sum(r for *_, r in judged) / len(judged) <= 0.3, own
+    assert model.analyse(["Over there."])[0].relevance_logit is None  # no history, nothing to judge
+    for e, history, is_relevant in judged:
+        if not is_relevant:
+            assert [(a.cls, a.start, a.end) for a in planner.acts(e.text, history)[1]] == \
+                [(a.cls, a.start, a.end) for a in planner.acts(e.text)[1]]
