@@ -104,7 +104,7 @@ class LocalPlanner:
                  training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
                  boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
                  variant_word_weight: float = 0.5, variant_shared_weight: float = 1.5, variant_class_weight: float = 0.0,
-                 bf16_inference: bool = True, trace_inference: bool = True) -> None:
+                 history_threshold: float = -1.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
@@ -117,6 +117,7 @@ class LocalPlanner:
         self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
         self.variant_weights, self.variant_class_weight = Weights(variant_word_weight, variant_shared_weight), variant_class_weight
         self.min_words, self.max_records = min_words, max_records
+        self.history_threshold = history_threshold
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
         self._load(retrain=False)  # first use trains: the train_local job's own call
 
@@ -149,7 +150,7 @@ class LocalPlanner:
         """Everything the split needs from the model: one forward pass over the dialogue and the utterance
         (two when the history turns out not to bear on it: the utterance is then read alone)."""
         analysis = self.model.analyse([utterance], [history])[0]
-        if analysis.relevance_logit is not None and analysis.relevance_logit < 0:
+        if analysis.relevance_logit is not None and analysis.relevance_logit < self.history_threshold:
             analysis = self.model.analyse([utterance])[0]
         pieces = segments(utterance) or [Segment(utterance, 0, len(utterance), True)]
         n = len(pieces)

@@ -104,16 +104,28 @@ def projected(projections, features: Features) -> tuple:
             torch.from_numpy(features.distinctive), features.words)
 
 
-def shared_words(words: tuple[np.ndarray, np.ndarray], motions: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
-    """(M,): per motion, the share of the act's rarity weight carried by tokens its description also has."""
+def word_presence(motion_words: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
+    """(M, V): 1 where motion m's description has token id v (V: one past the largest id present)."""
+    vocabulary = 1 + max((int(ids.max()) for ids, _ in motion_words if len(ids)), default=0)
+    present = np.zeros((len(motion_words), vocabulary), dtype=np.float32)
+    for m, (ids, _) in enumerate(motion_words):
+        present[m, ids] = 1.0
+    return present
+
+
+def shared_words(words: tuple[np.ndarray, np.ndarray], present: np.ndarray) -> np.ndarray:
+    """(M,): per motion, the share of the act's rarity weight carried by tokens its description also has.
+    present: word_presence() of the motions."""
     ids, weights = words
-    return np.array([weights[np.isin(ids, motion_ids)].sum() for motion_ids, _ in motions]) / max(weights.sum(), 1e-9)
+    known = ids < present.shape[1]
+    return present[:, ids[known]] @ weights[known] / max(float(weights.sum()), 1e-9)
 
 
 def scores(act: tuple, motions: tuple, weights: Weights) -> np.ndarray:
-    """(A, M) variant scores of A acts against M motions, both as projected() gives them."""
+    """(A, M) variant scores of A acts against M motions, both as projected() gives them, with the
+    motions' words tabulated by word_presence()."""
     dense = act[0] @ motions[0].T + act[1] @ motions[1].T + weights.word * act[2] @ motions[2].T
-    shared = np.stack([shared_words(words, motions[3]) for words in act[3]]) if motions[3] else 0.0
+    shared = np.stack([shared_words(words, motions[3]) for words in act[3]])
     return dense.numpy() + weights.shared * shared
 
 
@@ -201,7 +213,8 @@ class VariantChooser:
         if cached[0] != version:
             entries = catalogue()
             with torch.inference_mode():
-                motions = projected(self.projections, self.describe([text for _, text in entries.values()]))
+                *vectors, words = projected(self.projections, self.describe([text for _, text in entries.values()]))
+                motions = (*vectors, word_presence(words))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
             cached = self._cached = (version, list(entries), classes, motions)
         _, names, classes, motions = cached
