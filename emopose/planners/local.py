@@ -109,8 +109,11 @@ class LocalPlanner:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
                              ("variant_class_weight", variant_class_weight)):
-            if not weight >= 0:
+            if not isinstance(weight, int | float) or not weight >= 0:
                 raise ValueError(f"planner.{name} must be a number >= 0 (0 turns it off), got {weight!r}")
+        if not isinstance(history_threshold, int | float) or history_threshold != history_threshold:
+            raise ValueError(f"planner.history_threshold must be a number (-.inf keeps every history), "
+                             f"got {history_threshold!r}")
         self.library = library
         self.train_files = list(train_files)
         self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training or {})

@@ -1,4 +1,4 @@
-"""The local planner's model: all-MiniLM-L6-v2 with its top layers fine-tuned, three heads, two projections.
+"""The local planner's model: all-MiniLM-L6-v2 with its top layers fine-tuned, four heads, two projections.
 
 The encoder reads the dialogue and the utterance as one input: the last turns with role markers
 ("guide: ... visitor: ... [SEP] utterance"), so every utterance token attends to the history and an
@@ -6,7 +6,7 @@ elliptical reply ("That one, with the feathers.") is read in context; a relevanc
 the history bears on the utterance at all. Only the utterance's tokens are
 kept; their character starts are relative to the utterance. One forward pass gives three states per token:
 
-- class states from the fine-tuned top layers, read by the act, boundary and anchor heads
+- class states from the fine-tuned top layers, read by the act, boundary, anchor and relevance heads
   (planners/local_heads.py);
 - semantic states: the pretrained sentence encoder's own output (a frozen copy of the top layers run
   over the same lower states; mean-pooled, this is all-MiniLM-L6-v2's sentence embedding);
@@ -63,7 +63,8 @@ class Tokens:
 
 
 class ActModel:
-    """MiniLM + act / boundary / anchor heads and the variant projections: weights and the forward pass."""
+    """MiniLM + act / boundary / anchor / relevance heads and the variant projections: weights and the
+    forward pass."""
 
     def __init__(self, config: TrainingConfig) -> None:
         os.environ.setdefault("HF_HUB_OFFLINE", "1")  # before transformers reads it: never reach for a hub

@@ -27,7 +27,7 @@ import sys
 from emopose import CLASSES
 from emopose.planners.local_data import Example
 from emopose.planners.local_heads import boundary_features, pooled, token_range
-from emopose.planners.local_model import ActModel
+from emopose.planners.local_model import ActModel, context_prefix
 from emopose.planners.local_variants import AnnotatedAct, fit_variants
 from emopose.planners.semi_crf import log_partition, split_score
 
@@ -62,12 +62,12 @@ def fit(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str
     suite items). catalogue: motion name -> (class, description)."""
     import torch
 
-    previous = torch.are_deterministic_algorithms_enabled()
+    previous = torch.are_deterministic_algorithms_enabled(), torch.is_deterministic_algorithms_warn_only_enabled()
     torch.use_deterministic_algorithms(True)
     try:
         train(model, examples, catalogue or {}, progress)
     finally:
-        torch.use_deterministic_algorithms(previous)
+        torch.use_deterministic_algorithms(previous[0], warn_only=previous[1])
 
 
 def train(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[str, str]], progress: bool) -> None:
@@ -169,7 +169,7 @@ def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
                  for k in gold}
     vectors = pool.vectors()
     loss = cross_entropy(model.act_head(vectors[acts]) * cfg.logit_scale, act_labels)
-    after_history = [k for k, e in enumerate(batch) if e.history]
+    after_history = [k for k, e in enumerate(batch) if context_prefix(e.history)]
     if after_history and cfg.relevance_loss_weight:  # read from [CLS], which attends to history and utterance
         bears = torch.tensor([float(batch[k].history_bears) for k in after_history])
         logits = model.relevance_head(class_states[after_history, 0]).squeeze(-1)

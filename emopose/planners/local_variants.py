@@ -32,7 +32,7 @@ from __future__ import annotations
 import random
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -73,7 +73,7 @@ class Features:
     semantic: np.ndarray  # (N, D), normalised
     lexical: np.ndarray  # (N, D), normalised
     distinctive: np.ndarray  # (N, D), normalised
-    words: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)  # per text: (token ids, rarity weights)
+    words: list[tuple[np.ndarray, np.ndarray]]  # per text: (token ids, rarity weights)
 
     def __getitem__(self, k: int) -> Features:
         return Features(self.semantic[k:k + 1], self.lexical[k:k + 1], self.distinctive[k:k + 1], [self.words[k]])
@@ -81,7 +81,7 @@ class Features:
     @classmethod
     def stacked(cls, parts: list[Features], width: int) -> Features:
         if not parts:
-            return cls(*(np.zeros((0, width), dtype=np.float32) for _ in range(3)))
+            return cls(*(np.zeros((0, width), dtype=np.float32) for _ in range(3)), [])
         return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in ("semantic", "lexical", "distinctive")),
                    [w for p in parts for w in p.words])
 

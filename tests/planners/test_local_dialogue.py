@@ -58,9 +58,10 @@ def test_an_unrelated_history_barely_moves_held_out_items(planner):
 
 @pytest.mark.slow
 def test_a_history_that_does_not_bear_on_the_utterance_is_dropped(planner):
-    """The relevance head tells a dialogue's own history from another dialogue's (measured at its own
-    boundary, logit 0: 92.9 % of the held-out dialogues' own histories judged relevant, 16.8 % of unrelated
-    ones), and below the configured threshold the planner reads the utterance alone."""
+    """The relevance head tells a dialogue's own history from another dialogue's. Measured at its own
+    boundary, logit 0: 92.9 % of the held-out dialogues' own histories judged relevant, 80.1 % when the
+    same replies follow another dialogue's history (an elliptical reply fits many questions), 16.8 % for
+    items written without a dialogue. Below the configured threshold the planner reads the utterance alone."""
     items, dialogues = unrelated_histories(planner)
     model = planner.model
 
@@ -68,8 +69,10 @@ def test_a_history_that_does_not_bear_on_the_utterance_is_dropped(planner):
         return model.analyse([text], [history])[0].relevance_logit
 
     own = [relevance(e.text, e.history) for e in dialogues]
+    others = [relevance(e.text, dialogues[(k + 1) % len(dialogues)].history) for k, e in enumerate(dialogues)]
     judged = [(e, history, relevance(e.text, history)) for e, history in items[:120]]
-    assert sum(r >= 0 for r in own) / len(own) >= 0.85, own
+    own_rate = sum(r >= 0 for r in own) / len(own)
+    assert own_rate >= 0.85 and sum(r >= 0 for r in others) / len(others) <= own_rate - 0.05, own_rate
     assert sum(r >= 0 for *_, r in judged) / len(judged) <= 0.3
     assert model.analyse(["Over there."])[0].relevance_logit is None  # no history, nothing to judge
     dropped = [(e, history) for e, history, r in judged if r < planner.history_threshold]

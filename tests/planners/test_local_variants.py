@@ -82,9 +82,14 @@ def test_a_rare_word_the_description_also_says_decides_between_motions():
     # the vectors lean to palm_stop; the shared rare word outweighs them
     naughty = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 7]), np.array([0.01, 0.9])))
     assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, 0.0)[1] == "finger_wag"
-    # sharing only a frequent word carries no weight against the vectors
-    plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5]), np.array([0.01, 0.9])))
+    # sharing only a frequent word carries no weight against the vectors; a token no description has (an
+    # id past every description's) counts against the share
+    plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5, 30000]), np.array([0.01, 0.9, 0.9])))
     assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, 0.0)[1] == "palm_stop"
+
+
+def test_an_empty_library_leaves_the_class_without_a_motion(chooser):
+    assert chooser.choose(lambda: {}, 1, "doubting", proba(doubting=1.0), act_near("shrug"), 2.0) == ("doubting", None)
 
 
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
