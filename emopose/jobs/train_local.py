@@ -25,13 +25,20 @@ from emopose.resources import Run
 SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
 
 
-def context_metrics(planner: LocalPlanner, dialogues: list[Example]) -> dict:
-    """Top-1 of the dialogue items read with and without their history (fractions)."""
+def scored_dialogues(planner: LocalPlanner, dialogues: list[Example]) -> dict[bool, list[ScoredUtterance]]:
+    """The dialogue items' final utterances scored with their history (True) and without (False)."""
+    return {with_history: [planner.score(e.text, e.history if with_history else ()) for e in dialogues]
+            for with_history in (True, False)}
+
+
+def context_metrics(planner: LocalPlanner, dialogues: list[Example],
+                    scored: dict[bool, list[ScoredUtterance]]) -> dict:
+    """Top-1 of the dialogue items read with and without their history (fractions); scored as
+    scored_dialogues() gives them."""
     def top1(with_history: bool) -> float | None:
         if not dialogues:  # a planner trained without the dialogue split has none held out
             return None
-        first = [planner.best_split(planner.score(e.text, e.history if with_history else ()))[0]
-                 for e in dialogues]
+        first = [planner.best_split(s)[0] for s in scored[with_history]]
         return sum(a.cls == e.acts[0].label for a, e in zip(first, dialogues)) / len(dialogues)
 
     return {"context_with_history": top1(True), "context_without": top1(False), "dialogues": len(dialogues)}
@@ -93,7 +100,9 @@ class TrainLocalJob:
             planner.retrain()
         held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
         examples = [e for e in held_out if not e.history]
-        scored = [planner.score(e.text) for e in examples]
+        dialogues = [e for e in held_out if e.history]
+        scored = [planner.score(e.text) for e in examples]  # once: every setting re-splits the same scores
+        dialogue_scores = scored_dialogues(planner, dialogues)
         configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
         search = self.search or {}
         grid = [dict(zip(search, values)) for values in itertools.product(*search.values())]
@@ -103,7 +112,7 @@ class TrainLocalJob:
                 for name, value in {**configured, **setting}.items():
                     setattr(planner, name, value)
                 rows.append({**configured, **setting, **held_out_metrics(planner, examples, scored),
-                             **context_metrics(planner, [e for e in held_out if e.history])})
+                             **context_metrics(planner, dialogues, dialogue_scores)})
         finally:
             for name, value in configured.items():
                 setattr(planner, name, value)

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from emopose.planners.local_heads import Analysis, boundary_scores, span_scores, variant_features
-from emopose.planners.local_model import ActModel, context_prefix
+from emopose.planners.local_model import ActModel
 from emopose.planners.local_variants import Features
 from emopose.planners.segment import Segment
 
@@ -96,7 +96,6 @@ class LocalInference:
         head's logit that it bears on the text."""
         import torch
 
-        prefixed = [bool(context_prefix(h)) for h in histories] if histories else [False] * len(texts)
         with self._lock, torch.inference_mode():
             tokens = self.model.tokens(texts, histories)
             class_states, semantic = self._encoder(tokens.inputs)
@@ -105,7 +104,7 @@ class LocalInference:
             for k, idx in enumerate(tokens.real):
                 states = class_states[k, idx].float()
                 anchor = self.model.anchor_head(states).squeeze(-1).numpy()
-                relevance = float(self.model.relevance_head(class_states[k, 0].float())) if prefixed[k] else None
+                relevance = float(self.model.relevance_head(class_states[k, 0].float())) if tokens.prefixed[k] else None
                 out.append(Analysis(tokens.starts[k], states, semantic[k, idx].float(), words[k, idx], anchor,
                                     relevance, tokens.inputs["input_ids"][k, idx].numpy(), weights[k, idx]))
         return out

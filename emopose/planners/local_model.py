@@ -60,6 +60,7 @@ class Tokens:
     inputs: dict  # model inputs (B, T)
     starts: list[list[int]]  # per text: character start of each utterance token, relative to the utterance
     real: list[list[int]]  # per text: positions of the utterance tokens in the input
+    prefixed: list[bool]  # per text: whether a dialogue history precedes it in the input
 
 
 class ActModel:
@@ -101,7 +102,7 @@ class ActModel:
         if not all(real):  # only when the prefix filled MAX_TOKENS, which CONTEXT_CHARS rules out
             raise ValueError("the dialogue history left no room for the utterance")
         starts = [[offsets[k][t][0] - len(prefixes[k]) for t in idx] for k, idx in enumerate(real)]
-        return Tokens(dict(batch), starts, real)
+        return Tokens(dict(batch), starts, real, [bool(p) for p in prefixes])
 
     def encode(self, body, sentence_top, inputs: dict) -> tuple:
         """(class states from the fine-tuned top, semantic states from the pretrained top), (B, T, D)."""

@@ -27,7 +27,7 @@ import sys
 from emopose import CLASSES
 from emopose.planners.local_data import Example
 from emopose.planners.local_heads import boundary_features, pooled, token_range
-from emopose.planners.local_model import ActModel, context_prefix
+from emopose.planners.local_model import ActModel
 from emopose.planners.local_variants import AnnotatedAct, fit_variants
 from emopose.planners.semi_crf import log_partition, split_score
 
@@ -169,7 +169,7 @@ def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
                  for k in gold}
     vectors = pool.vectors()
     loss = cross_entropy(model.act_head(vectors[acts]) * cfg.logit_scale, act_labels)
-    after_history = [k for k, e in enumerate(batch) if context_prefix(e.history)]
+    after_history = [k for k, read_after in enumerate(tokens.prefixed) if read_after]
     if after_history and cfg.relevance_loss_weight:  # read from [CLS], which attends to history and utterance
         bears = torch.tensor([float(batch[k].history_bears) for k in after_history])
         logits = model.relevance_head(class_states[after_history, 0]).squeeze(-1)

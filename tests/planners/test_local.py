@@ -122,13 +122,14 @@ def planner(tmp_path_factory):
 
 @pytest.mark.slow
 def test_quality_floor_on_held_out_training_slice(planner):
-    from emopose.jobs.train_local import context_metrics, held_out_metrics
+    from emopose.jobs.train_local import context_metrics, held_out_metrics, scored_dialogues
     from emopose.planners.local_data import load_examples
 
     held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
     utterances = [e for e in held_out if not e.history]
     metrics = held_out_metrics(planner, utterances, [planner.score(e.text) for e in utterances])
-    metrics.update(context_metrics(planner, [e for e in held_out if e.history]))
+    dialogues = [e for e in held_out if e.history]
+    metrics.update(context_metrics(planner, dialogues, scored_dialogues(planner, dialogues)))
     # Measured (seeded, `+experiment=train_local`): single top-1 87.1 %, sequence exact 61.4 %, anchor
     # recall 84.9 %, exact variant 52.1 %, dialogues 86.3 % with history, 72.0 % without. Floors leave
     # about 3 points for training on another CPU (bfloat16 support and thread counts change the sums).
