@@ -100,11 +100,10 @@ def softmax(logits: np.ndarray) -> np.ndarray:
 class LocalPlanner:
     name = "local"
 
-    def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str = "~/.cache/emopose",
-                 training: dict | None = None, min_words: int = 2, temperature: float = 1.0,
-                 boundary_weight: float = 1.0, act_cost: float = 0.0, max_records: int = 4,
-                 variant_word_weight: float = 0.5, variant_shared_weight: float = 1.5, variant_class_weight: float = 0.0,
-                 history_threshold: float = -1.5, bf16_inference: bool = True, trace_inference: bool = True) -> None:
+    def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str, training: dict,
+                 min_words: int, temperature: float, boundary_weight: float, act_cost: float, max_records: int,
+                 variant_word_weight: float, variant_shared_weight: float, variant_class_weight: float,
+                 history_threshold: float, bf16_inference: bool, trace_inference: bool) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
@@ -116,7 +115,7 @@ class LocalPlanner:
                              f"got {history_threshold!r}")
         self.library = library
         self.train_files = list(train_files)
-        self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training or {})
+        self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training)
         self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
         self.variant_weights, self.variant_class_weight = Weights(variant_word_weight, variant_shared_weight), variant_class_weight
         self.min_words, self.max_records = min_words, max_records

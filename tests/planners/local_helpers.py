@@ -1,4 +1,5 @@
-"""The configured local planner (same training files and cache as the app) on a writable library copy."""
+"""The configured local planner (same training files and cache as the app) on a writable library copy,
+and its training settings."""
 
 from __future__ import annotations
 
@@ -7,6 +8,17 @@ from pathlib import Path
 
 from emopose.config import PROJECT_ROOT
 from emopose.library import MotionLibrary
+
+
+def training_config(**changes):
+    """conf/planner/local.yaml's training settings (the one place they live), with changes."""
+    from omegaconf import OmegaConf
+
+    from emopose.planners.local_config import TrainingConfig
+    from tests.conftest import compose_config
+
+    return TrainingConfig(**{**OmegaConf.to_container(compose_config(["planner=local"]).planner.training,
+                                                      resolve=True), **changes})
 
 
 def configured_local_planner(folder: Path, *overrides: str):

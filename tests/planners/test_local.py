@@ -92,6 +92,7 @@ def test_train_local_search_is_checked_before_anything_is_built():
     ("planner.training.lr=-0.1", "lr\n  Input should be greater than or equal to 0"),
     ("planner.training.trainable_layers=7", "trainable_layers\n  Input should be less than or equal to 6"),
     ("+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
+    ("~planner.training.epochs", "epochs\n  Field required"),  # the YAML is the one place of every value
     ("planner.temperature=0", "temperature must be positive"),
     ("planner.variant_class_weight=-1", "variant_class_weight must be a number >= 0"),
     ("planner.variant_shared_weight=-0.5", "variant_shared_weight must be a number >= 0"),

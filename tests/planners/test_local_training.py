@@ -6,9 +6,9 @@ import json
 
 import pytest
 
-from emopose.planners.local_config import TrainingConfig
 from emopose.planners.local_data import load_examples
 from emopose.planners.local_model import CONTEXT_CHARS, ActModel, context_prefix
+from tests.planners.local_helpers import training_config
 
 DIALOGUE = ({"role": "user", "content": "Can my son touch the starfish?"},
             {"role": "assistant", "content": "Of course. I could also take him behind the scenes."})
@@ -31,7 +31,7 @@ def test_context_prefix_marks_roles_and_keeps_the_latest_turns():
 
 @pytest.fixture(scope="module")
 def model():
-    return ActModel(TrainingConfig(trainable_layers=1, epochs=2, batch_size=4))
+    return ActModel(training_config(trainable_layers=1, epochs=2, batch_size=4))
 
 
 def test_utterance_tokens_are_read_in_context_but_located_in_the_utterance(model):
@@ -90,8 +90,8 @@ def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, 
 def test_linear_schedule_warms_up_then_decays_to_zero():
     from emopose.planners.local_training import learning_rate_factor
 
-    factor = learning_rate_factor(TrainingConfig(lr_schedule="linear"), 100)
+    factor = learning_rate_factor(training_config(lr_schedule="linear"), 100)
     rates = [factor(step) for step in range(100)]
     assert rates[0] == pytest.approx(0.2) and rates[4] == pytest.approx(1.0)  # 5 warm-up steps
     assert all(a >= b for a, b in zip(rates[4:], rates[5:])) and rates[-1] == pytest.approx(1 / 95)
-    assert {learning_rate_factor(TrainingConfig(), 100)(step) for step in range(100)} == {1.0}
+    assert {learning_rate_factor(training_config(lr_schedule="constant"), 100)(step) for step in range(100)} == {1.0}
