@@ -1,8 +1,8 @@
 """The local planner's training hyper-parameters, validated where they enter (planner.training).
 
 Their values live in one place, conf/planner/local.yaml; this model only checks them, so every field
-is required (a missing one is an error naming it). Every field is part of the trained artifact's cache key (planners/local_artifact.py): changing one
-trains a new model, the old artifact stays on disk.
+is required (a missing one is an error naming it). Every field is part of the trained artifact's cache
+key (planners/local_artifact.py): changing one trains a new model, the old artifact stays on disk.
 """
 
 from __future__ import annotations

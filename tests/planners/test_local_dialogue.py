@@ -43,9 +43,9 @@ def unrelated_histories(planner):
 def test_an_unrelated_history_barely_moves_held_out_items(planner):
     """Held-out single- and multi-act training items read after the history of a held-out dialogue that
     has nothing to do with them keep their classes and split. Measured (seeded): singles 87.8 % alone,
-    83.9 % after (80.6 % with the history always read), multi-act items 64.9 % alone, 63.2 % after (61.0 %); before
-    the relevance head 87.1 -> 81.4 and 62.7 -> 61.0; a model trained with single-act distractors only
-    dropped the multi-act items from 62.7 % to 29.8 % when it read them in context."""
+    83.9 % after (80.6 % with the history always read), multi-act items 64.9 % alone, 63.2 % after
+    (61.0 %); before the relevance head 87.1 -> 81.4 and 62.7 -> 61.0; a model trained with single-act
+    distractors only dropped the multi-act items from 62.7 % to 29.8 % when it read them in context."""
     items, _ = unrelated_histories(planner)
 
     def exact(with_history: bool) -> float:
@@ -62,7 +62,8 @@ def test_a_history_that_does_not_bear_on_the_utterance_is_dropped(planner):
     boundary, logit 0: 94.8 % of the held-out dialogues' own histories judged relevant, 84.8 % when the
     same replies follow another dialogue's history (an elliptical reply fits many questions), 30.0 % for
     items written without a dialogue (16.8 % when trained in batches of 32: the boundary moved, the
-    configured threshold still drops 58 % of them). Below that threshold the planner reads the utterance alone."""
+    configured threshold still drops 58 % of them). Below that threshold the planner reads the utterance
+    alone."""
     items, dialogues = unrelated_histories(planner)
     model = planner.model
 

@@ -25,9 +25,10 @@ def planner(tmp_path_factory):
 
 
 # Measured: picked for 5/5/3/5/5 of the utterances (sailor_salute, thumbs_up, finger_wag, head_scratch,
-# point_down); the target is >= 4 of 5 each. Given the right class, 24/25: one finger_wag miss is a
-# class error (a scolded kitten read as comforting), one picks palm_stop ("no, no, no" fits both). 5/5/2/5/5 without the shared-word term,
-# 2/2/1/0/4 by the earlier utterance-only planner. The floors leave a pick for training on another CPU.
+# point_down); the target is >= 4 of 5 each. Given the right class, 24/25: one finger_wag miss is
+# a class error (a scolded kitten read as comforting), one picks palm_stop ("no, no, no" fits both).
+# Earlier models: 5/5/2/5/5 without the shared-word term, 2/2/1/0/4 by the utterance-only planner.
+# The floors leave a pick for training on another CPU.
 @pytest.mark.slow
 def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
     rows = [json.loads(line) for line in (NEW / "utterances.jsonl").read_text().splitlines()]
