@@ -102,14 +102,17 @@ class LocalPlanner:
 
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str, training: dict,
                  min_words: int, temperature: float, boundary_weight: float, act_cost: float, max_records: int,
-                 variant_word_weight: float, variant_shared_weight: float, variant_class_weight: float,
-                 history_threshold: float, bf16_inference: bool, trace_inference: bool) -> None:
+                 variant_word_weight: float, variant_shared_weight: float, variant_pretrained_share: float,
+                 variant_class_weight: float, history_threshold: float, bf16_inference: bool, trace_inference: bool) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
                              ("variant_class_weight", variant_class_weight)):
             if not isinstance(weight, int | float) or not weight >= 0:
                 raise ValueError(f"planner.{name} must be a number >= 0 (0 turns it off), got {weight!r}")
+        if not isinstance(variant_pretrained_share, int | float) or not 0 <= variant_pretrained_share <= 1:
+            raise ValueError(f"planner.variant_pretrained_share must be a number from 0 to 1, "
+                             f"got {variant_pretrained_share!r}")
         if not isinstance(history_threshold, int | float) or history_threshold != history_threshold:
             raise ValueError(f"planner.history_threshold must be a number (-.inf keeps every history), "
                              f"got {history_threshold!r}")
@@ -117,7 +120,8 @@ class LocalPlanner:
         self.train_files = list(train_files)
         self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training)
         self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
-        self.variant_weights, self.variant_class_weight = Weights(variant_word_weight, variant_shared_weight), variant_class_weight
+        self.variant_weights = Weights(variant_word_weight, variant_shared_weight, variant_pretrained_share)
+        self.variant_class_weight = variant_class_weight
         self.min_words, self.max_records = min_words, max_records
         self.history_threshold = history_threshold
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost

@@ -10,7 +10,8 @@ and their tokens with rarity weights (Features):
   the training texts (smooth inverse frequency): "baffled", "thumbs", "floor" count, "I" and "the" do not;
 - words: the token ids with the same rarity weights.
 
-score(act, motion) = cos(Ps a, Ps m) over the semantic vectors + cos(Pl a, Pl m) over the lexical ones
+score(act, motion) = (1 - q) * [cos(Ps a, Ps m) over the semantic vectors + cos(Pl a, Pl m) over the lexical ones]
+                     + q * [cos(a, m) over the semantic vectors + cos(a, m) over the lexical ones]
                      + word_weight * cos(a, m) over the distinctive ones
                      + shared_weight * (share of the act's rarity weight in words the description also uses).
 
@@ -18,7 +19,9 @@ Ps and Pl start as the identity and are trained on the annotated variants of the
 on its own similarity, with a random share of each class's motions left out of every batch, so they
 learn what in an utterance points at a description, not which motions the data favours. The two
 untrained terms keep a new motion's own words decisive: a motion added by file is scored like a known
-one, without retraining. The shared-word term counts only words both texts say, so it adds nothing for
+one, without retraining. Even so the projections lean toward what the annotated data calls each known
+motion; q (pretrained_share), a share of the pretrained encoder's own similarity, keeps part of the dense
+terms free of that. The shared-word term counts only words both texts say, so it adds nothing for
 descriptions that merely sound alike (the averaged distinctive vectors do; leaning on the shared words,
 known motions lose fewer acts to new ones). The projections read only frozen states, so they are
 trained apart from the encoder, in seconds, after its epochs (planners/local_training.py).
@@ -92,16 +95,17 @@ class Weights:
 
     word: float  # the distinctive vectors' cosine
     shared: float  # the share of the act's rarity weight in words the description also uses
+    pretrained_share: float  # of the semantic and lexical cosines, the share taken before the projections
 
 
 def projected(projections, features: Features) -> tuple:
-    """(semantic, lexical, distinctive, words) as the score compares them: the first two through their
-    projections, normalised (torch)."""
+    """(semantic and lexical through their projections, normalised; semantic, lexical, distinctive as
+    read; words): what the score compares (torch)."""
     import torch
 
-    return (unit(projections[0], torch.from_numpy(features.semantic)),
-            unit(projections[1], torch.from_numpy(features.lexical)),
-            torch.from_numpy(features.distinctive), features.words)
+    semantic, lexical = torch.from_numpy(features.semantic), torch.from_numpy(features.lexical)
+    return (unit(projections[0], semantic), unit(projections[1], lexical),
+            semantic, lexical, torch.from_numpy(features.distinctive), features.words)
 
 
 def word_presence(motion_words: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
@@ -124,8 +128,11 @@ def shared_words(words: tuple[np.ndarray, np.ndarray], present: np.ndarray) -> n
 def scores(act: tuple, motions: tuple, weights: Weights) -> np.ndarray:
     """(A, M) variant scores of A acts against M motions, both as projected() gives them, with the
     motions' words tabulated by word_presence()."""
-    dense = act[0] @ motions[0].T + act[1] @ motions[1].T + weights.word * act[2] @ motions[2].T
-    shared = np.stack([shared_words(words, motions[3]) for words in act[3]])
+    trained = act[0] @ motions[0].T + act[1] @ motions[1].T
+    pretrained = act[2] @ motions[2].T + act[3] @ motions[3].T
+    q = weights.pretrained_share
+    dense = (1 - q) * trained + q * pretrained + weights.word * act[4] @ motions[4].T
+    shared = np.stack([shared_words(words, motions[5]) for words in act[5]])
     return dense.numpy() + weights.shared * shared
 
 

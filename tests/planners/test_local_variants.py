@@ -43,7 +43,7 @@ def proba(**by_class: float) -> np.ndarray:
 
 @pytest.fixture
 def chooser():
-    return VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0))
+    return VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0))
 
 
 def test_the_best_fitting_motion_of_the_class_is_chosen(chooser):
@@ -78,7 +78,7 @@ def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser
 def test_a_rare_word_the_description_also_says_decides_between_motions():
     # token ids: 7 "naughty" (rare), 1 "the" (frequent); only finger_wag's description says "naughty"
     words = {"finger_wag": (np.array([7, 1]), np.array([0.9, 0.01])), "palm_stop": (np.array([1]), np.array([0.01]))}
-    chooser = VariantChooser(new_projections(4), lambda texts: describe(texts, words), Weights(word=0.0, shared=1.0))
+    chooser = VariantChooser(new_projections(4), lambda texts: describe(texts, words), Weights(word=0.0, shared=1.0, pretrained_share=0.0))
     # the vectors lean to palm_stop; the shared rare word outweighs them
     naughty = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 7]), np.array([0.01, 0.9])))
     assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, 0.0)[1] == "finger_wag"
@@ -86,6 +86,25 @@ def test_a_rare_word_the_description_also_says_decides_between_motions():
     # id past every description's) counts against the share
     plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5, 30000]), np.array([0.01, 0.9, 0.9])))
     assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, 0.0)[1] == "palm_stop"
+
+
+def test_a_share_of_the_pretrained_similarity_keeps_a_motion_the_projections_lost():
+    import torch
+
+    # projections trained where no annotated act needed finger_wag's direction: they drop that axis, so
+    # through them a scolding reads only as its small share of palm_stop
+    projections = new_projections(4)
+    with torch.no_grad():
+        for projection in projections:
+            projection.weight[:, AXIS["finger_wag"]] = 0.0
+    scolding = act_near("finger_wag", "palm_stop", 0.1)
+
+    def chosen(share: float) -> str | None:
+        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=share))
+        return chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), scolding, 0.0)[1]
+
+    assert chosen(0.0) == "palm_stop"
+    assert chosen(0.75) == "finger_wag"  # the pretrained cosines still see which description it is near
 
 
 def test_an_empty_library_leaves_the_class_without_a_motion(chooser):
@@ -116,7 +135,7 @@ def test_projections_learn_the_annotated_motion():
     projections = new_projections(4)
 
     def chosen() -> str | None:
-        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0))
+        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=0.0))
         act = Features(vector[None], vector[None], vector[None], [NO_WORDS])
         return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), act, 0.0)[1]
 
