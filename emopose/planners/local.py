@@ -34,7 +34,7 @@ from emopose.planners.local_artifact import load_model, train_artifact
 from emopose.planners.local_config import TrainingConfig
 from emopose.planners.local_heads import Analysis
 from emopose.planners.local_inference import LocalInference
-from emopose.planners.local_variants import Features, VariantChooser, Weights
+from emopose.planners.local_variants import ClassMove, Features, VariantChooser, Weights
 from emopose.planners.segment import Segment, segments
 
 _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|truly|definitely|never|"
@@ -103,11 +103,12 @@ class LocalPlanner:
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str, training: dict,
                  min_words: int, temperature: float, boundary_weight: float, act_cost: float, max_records: int,
                  variant_word_weight: float, variant_shared_weight: float, variant_pretrained_share: float,
-                 variant_class_weight: float, history_threshold: float, bf16_inference: bool, trace_inference: bool) -> None:
+                 variant_class_weight: float, variant_class_weight_new: float, history_threshold: float, bf16_inference: bool, trace_inference: bool) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
-                             ("variant_class_weight", variant_class_weight)):
+                             ("variant_class_weight", variant_class_weight),
+                             ("variant_class_weight_new", variant_class_weight_new)):
             if not isinstance(weight, int | float) or not weight >= 0:
                 raise ValueError(f"planner.{name} must be a number >= 0 (0 turns it off), got {weight!r}")
         if not isinstance(variant_pretrained_share, int | float) or not 0 <= variant_pretrained_share <= 1:
@@ -121,7 +122,7 @@ class LocalPlanner:
         self.cache_dir, self.config = cache_dir, TrainingConfig.model_validate(training)
         self.bf16_inference, self.trace_inference = bf16_inference, trace_inference
         self.variant_weights = Weights(variant_word_weight, variant_shared_weight, variant_pretrained_share)
-        self.variant_class_weight = variant_class_weight
+        self.class_move = ClassMove(variant_class_weight, variant_class_weight_new)
         self.min_words, self.max_records = min_words, max_records
         self.history_threshold = history_threshold
         self.temperature, self.boundary_weight, self.act_cost = temperature, boundary_weight, act_cost
@@ -130,7 +131,9 @@ class LocalPlanner:
     def _load(self, retrain: bool) -> None:
         artifact = train_artifact(self.train_files, self.cache_dir, self.config, self._catalogue(), retrain)
         self.model = LocalInference(load_model(artifact, self.config), self.bf16_inference, self.trace_inference)
-        self.variants = VariantChooser(self.model.model.variant_projections, self.model.describe, self.variant_weights)
+        model = self.model.model
+        self.variants = VariantChooser(model.variant_projections, self.model.describe, self.variant_weights,
+                                       frozenset(model.trained_motions))
 
     def retrain(self) -> None:
         """Train again (replacing the cached artifact) and use the new model."""
@@ -172,7 +175,8 @@ class LocalPlanner:
         an act starting inside the utterance adds boundary_weight * its boundary logit - act_cost.
         The model is trained with (1, 1, 0); the knobs are for the held-out sweep in train_local.
         Each act's motion is chosen with its class (planners/local_variants.py), which may move an unsure
-        act to the class of a motion that fits its words clearly better (variant_class_weight)."""
+        act to the class of a motion that fits its words clearly better (variant_class_weight, and
+        variant_class_weight_new for a motion the training data never annotated)."""
         pieces, spans = scored.pieces, scored.spans
         openings = self.boundary_weight * scored.boundaries - self.act_cost
         split = semi_crf.best_split(len(pieces), spans, scored.logits / self.temperature, openings)
@@ -182,7 +186,7 @@ class LocalPlanner:
             neighbours = {acts[-1].cls} if acts else set()  # neighbouring acts keep differing in class
             neighbours |= {CLASSES[split[n + 1][1]]} if n + 1 < len(split) else set()
             cls, variant = self.variants.choose(self._catalogue, self.library.version, CLASSES[c], proba,
-                                                scored.features[k], self.variant_class_weight,
+                                                scored.features[k], self.class_move,
                                                 frozenset(neighbours))
             acts.append(_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, cls, proba, variant))
         return acts

@@ -26,8 +26,9 @@ descriptions that merely sound alike (the averaged distinctive vectors do; leani
 known motions lose fewer acts to new ones). The projections read only frozen states, so they are
 trained apart from the encoder, in seconds, after its epochs (planners/local_training.py).
 
-The class is chosen with the motion (VariantChooser.choose): log p(class) + class_weight * score, so a
-motion that fits an act's words clearly better can move an act the split model was unsure about.
+The class is chosen with the motion (VariantChooser.choose): log p(class) + w * (score - the act's mean
+score), so a motion that fits an act's words clearly better can move an act the split model was unsure
+about; w is larger for a motion the training data never annotated, whose uses the class head cannot know.
 """
 
 from __future__ import annotations
@@ -195,25 +196,36 @@ def fit_variants(projections, acts: list[AnnotatedAct], described: dict[str, tup
             optimizer.step()
 
 
+@dataclass(frozen=True)
+class ClassMove:
+    """How far a motion that fits an act's words better may move the act's class (conf/planner/local.yaml)."""
+
+    trained: float  # toward a motion the training data annotates: the class head has read acts about it
+    new: float  # toward one it never saw: the motion's description is the only evidence for its uses
+
+
 class VariantChooser:
     """Inference: an act's class and motion. The descriptions are read and projected once per library
-    version. describe(texts) -> their Features."""
+    version. describe(texts) -> their Features; trained: the motions the training data annotates."""
 
-    def __init__(self, projections, describe: Callable[[list[str]], Features], weights: Weights) -> None:
-        self.projections, self.describe, self.weights = projections, describe, weights
-        self._cached: tuple = (-1, [], np.zeros(0, dtype=int), ())
+    def __init__(self, projections, describe: Callable[[list[str]], Features], weights: Weights,
+                 trained: frozenset[str]) -> None:
+        self.projections, self.describe, self.weights, self.trained = projections, describe, weights, trained
+        self._cached: tuple = (-1, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool), ())
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, str]]], version: int, cls: str,
-               proba: np.ndarray, act: Features, class_weight: float,
+               proba: np.ndarray, act: Features, move: ClassMove,
                excluded: frozenset[str] = frozenset()) -> tuple[str, str | None]:
-        """(class, motion) for an act the split model reads as cls with class probabilities proba: the
-        class c maximising log proba[c] + class_weight * (its best motion's score), and that motion. With
-        class_weight 0, or when cls has no motion, the class stays cls; otherwise a class the model found
-        less likely wins only when one of its motions fits the act's words clearly better (a new "finger
-        wag" motion for a scolding the model half read as comforting). Classes in excluded (the
-        neighbouring acts') are never moved to. catalogue() -> the live library's selectable motions,
-        name -> (class, description text), read again when the library's version changes. act: the act's
-        Features (one row)."""
+        """(class, motion) for an act the split model reads as cls with class probabilities proba. Each
+        class offers its best-scoring motion m; the class maximising log proba[c] + w(m) * (score(m) - the
+        act's mean score over the library) wins, with that motion. w(m) is move.trained for a motion the
+        training data annotates and move.new for one it never saw: the class head's probabilities already
+        weigh what the data says of a known motion's uses, while for a new one (a "finger wag" added by
+        file, for a scolding the model half read as comforting) the fit is all there is. With both weights
+        0, or when cls has no motion, the class stays cls. Classes in excluded (the neighbouring acts')
+        are never moved to. catalogue() -> the live library's selectable motions, name -> (class,
+        description text), read again when the library's version changes. act: the act's Features (one
+        row)."""
         import torch
 
         cached = self._cached  # one read: another thread may replace it
@@ -223,18 +235,24 @@ class VariantChooser:
                 *vectors, words = projected(self.projections, self.describe([text for _, text in entries.values()]))
                 motions = (*vectors, word_presence(words))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
-            cached = self._cached = (version, list(entries), classes, motions)
-        _, names, classes, motions = cached
-        own = classes == CLASSES.index(cls)
-        if not own.any():
+            trained = np.array([name in self.trained for name in entries], dtype=bool)
+            cached = self._cached = (version, list(entries), classes, trained, motions)
+        _, names, classes, trained, motions = cached
+        own = CLASSES.index(cls)
+        if not (classes == own).any():
             return cls, None
         with torch.inference_mode():
             row = scores(projected(self.projections, act), motions, self.weights)[0]
-        if class_weight:
-            others = ~own & ~np.isin(classes, [CLASSES.index(c) for c in excluded])
-            # per motion: its class's log-probability plus the weighted fit; the best motion names the class
-            total = np.where(own | others, np.log(proba[classes] + 1e-12) + class_weight * row, -np.inf)
-        else:
-            total = np.where(own, row, -np.inf)
-        best = int(np.argmax(total))
-        return CLASSES[classes[best]], names[best]
+        fit = row - row.mean()
+        weight = np.where(trained, move.trained, move.new)
+        best_total, best_motion = -np.inf, None
+        # the split model's class first: a tie keeps it
+        for c in [own, *(c for c in set(classes.tolist()) - {own} if CLASSES[c] not in excluded)]:
+            members = np.flatnonzero(classes == c)
+            m = members[int(np.argmax(row[members]))]
+            if c != own and not weight[m]:
+                continue  # no weight, no move (the split may have chosen a less likely class for a reason)
+            total = np.log(proba[c] + 1e-12) + weight[m] * fit[m]
+            if total > best_total:
+                best_total, best_motion = total, m
+        return CLASSES[classes[best_motion]], names[best_motion]

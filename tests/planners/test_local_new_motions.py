@@ -24,6 +24,13 @@ def planner(tmp_path_factory):
     return configured_local_planner(tmp_path_factory.mktemp("lib") / "g1")
 
 
+def add_new_motions(planner) -> None:
+    folder = planner.library.snapshot.files["shrug"].parent  # the fixture's writable copy
+    for motion_file in NEW.glob("*.yaml"):
+        shutil.copy(motion_file, folder)
+    planner.library.reload()
+
+
 # Measured: picked for 5/5/4/5/5 of the utterances (sailor_salute, thumbs_up, finger_wag, head_scratch,
 # point_down); the target is >= 4 of 5 each. The finger_wag miss is a class error (a scolded
 # kitten read as comforting); without the pretrained share of the variant score palm_stop also took
@@ -33,10 +40,7 @@ def planner(tmp_path_factory):
 @pytest.mark.slow
 def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
     rows = [json.loads(line) for line in (NEW / "utterances.jsonl").read_text().splitlines()]
-    folder = planner.library.snapshot.files["shrug"].parent  # the fixture's writable copy
-    for motion_file in NEW.glob("*.yaml"):
-        shutil.copy(motion_file, folder)
-    planner.library.reload()
+    add_new_motions(planner)
     assert {r["motion"] for r in rows} <= set(planner.library.snapshot.entries)
     picked: Counter = Counter()
     for row in rows:
@@ -44,3 +48,22 @@ def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
         picked[row["motion"]] += any(g["variant"] == row["motion"] for g in gestures[:1])
     per_motion = {m: picked[m] / sum(r["motion"] == m for r in rows) for m in {r["motion"] for r in rows}}
     assert min(per_motion.values()) >= 0.6 and sum(picked.values()) >= 0.88 * len(rows), per_motion
+
+
+# Measured on the held-out slice: singles 87.8 -> 87.1 %, sequences exact 65.4 -> 64.9 % once the five are
+# in the library (a new motion's fit may move an act's class further than a known one's:
+# variant_class_weight_new); with 49 new motions 85.3 / 64.5.
+@pytest.mark.slow
+def test_new_motions_cost_the_reading_of_other_utterances_little(tmp_path):
+    from emopose.jobs.train_local import held_out_metrics
+    from emopose.planners.local_data import load_examples
+
+    planner = configured_local_planner(tmp_path / "g1")
+    examples = [e for e in load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
+                if not e.history]
+    scored = [planner.score(e.text) for e in examples]
+    before = held_out_metrics(planner, examples, scored)
+    add_new_motions(planner)
+    after = held_out_metrics(planner, examples, scored)
+    assert after["single_top1"] >= before["single_top1"] - 0.02, (before, after)
+    assert after["sequence_exact"] >= before["sequence_exact"] - 0.02, (before, after)

@@ -10,6 +10,7 @@ import pytest
 from emopose import CLASSES
 from emopose.planners.local_variants import (
     AnnotatedAct,
+    ClassMove,
     Features,
     VariantChooser,
     Weights,
@@ -21,6 +22,7 @@ CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who know
              "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}
 AXIS = {name: k for k, name in enumerate(CATALOGUE)}  # each motion's description is one axis of a 4-D space
 NO_WORDS = (np.zeros(0, dtype=int), np.zeros(0, dtype=np.float32))
+STAY, MOVE = ClassMove(trained=0.0, new=0.0), ClassMove(trained=2.0, new=2.0)
 
 
 def describe(texts: list[str], words: dict[str, tuple] | None = None) -> Features:
@@ -43,49 +45,67 @@ def proba(**by_class: float) -> np.ndarray:
 
 @pytest.fixture
 def chooser():
-    return VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0))
+    return VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0),
+                          frozenset(CATALOGUE))
 
 
 def test_the_best_fitting_motion_of_the_class_is_chosen(chooser):
     unsure = proba(doubting=0.6, rejecting=0.4)
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("shrug"), 0.0) == ("doubting", "shrug")
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("shrug"), STAY) == ("doubting", "shrug")
     # without the class weight the class is the split model's, even when another class's motion fits
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("finger_wag"), 0.0)[0] == "doubting"
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("finger_wag"), STAY)[0] == "doubting"
 
 
 def test_a_clearly_better_motion_may_move_an_unsure_act_but_not_a_sure_one(chooser):
     scolding = act_near("finger_wag")
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), scolding,
-                          2.0) == ("rejecting", "finger_wag")
+                          MOVE) == ("rejecting", "finger_wag")
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.999), scolding,
-                          2.0) == ("doubting", "chin_stroke")
+                          MOVE) == ("doubting", "chin_stroke")
     # an act that fits a doubting motion as well as the rejecting one keeps the likelier class
     even = act_near("chin_stroke", "finger_wag", 0.5)
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
-                          2.0)[0] == "doubting"
+                          MOVE)[0] == "doubting"
+
+
+def test_a_motion_the_training_data_never_annotated_moves_the_class_further():
+    # finger_wag was added by file: the class head never read an act about it
+    chooser = VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0),
+                             frozenset(CATALOGUE) - {"finger_wag"})
+    scolding, sure = act_near("finger_wag"), proba(doubting=0.999)
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding, MOVE)[0] == "doubting"
+    # the class head was sure without knowing the new motion; its clear fit moves the act all the same
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding,
+                          ClassMove(trained=2.0, new=8.0)) == ("rejecting", "finger_wag")
+    # the larger weight is the new motion's alone: a trained one fitting as well moves no further
+    known = VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0),
+                           frozenset(CATALOGUE))
+    assert known.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding,
+                        ClassMove(trained=2.0, new=8.0))[0] == "doubting"
 
 
 def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser):
     scolding = act_near("finger_wag")
     unsure = proba(doubting=0.6, rejecting=0.4)
     # the split model's class has no motion in the library: it stays, without a motion
-    assert chooser.choose(lambda: CATALOGUE, 1, "neutral", proba(neutral=0.99), scolding, 2.0) == ("neutral", None)
+    assert chooser.choose(lambda: CATALOGUE, 1, "neutral", proba(neutral=0.99), scolding, MOVE) == ("neutral", None)
     # the act next to it is already rejecting: neighbouring acts keep differing in class
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, scolding, 2.0,
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, scolding, MOVE,
                           frozenset({"rejecting"}))[0] == "doubting"
 
 
 def test_a_rare_word_the_description_also_says_decides_between_motions():
     # token ids: 7 "naughty" (rare), 1 "the" (frequent); only finger_wag's description says "naughty"
     words = {"finger_wag": (np.array([7, 1]), np.array([0.9, 0.01])), "palm_stop": (np.array([1]), np.array([0.01]))}
-    chooser = VariantChooser(new_projections(4), lambda texts: describe(texts, words), Weights(word=0.0, shared=1.0, pretrained_share=0.0))
+    chooser = VariantChooser(new_projections(4), lambda texts: describe(texts, words),
+                             Weights(word=0.0, shared=1.0, pretrained_share=0.0), frozenset(CATALOGUE))
     # the vectors lean to palm_stop; the shared rare word outweighs them
     naughty = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 7]), np.array([0.01, 0.9])))
-    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, 0.0)[1] == "finger_wag"
+    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, STAY)[1] == "finger_wag"
     # sharing only a frequent word carries no weight against the vectors; a token no description has (an
     # id past every description's) counts against the share
     plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5, 30000]), np.array([0.01, 0.9, 0.9])))
-    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, 0.0)[1] == "palm_stop"
+    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, STAY)[1] == "palm_stop"
 
 
 def test_a_share_of_the_pretrained_similarity_keeps_a_motion_the_projections_lost():
@@ -100,15 +120,16 @@ def test_a_share_of_the_pretrained_similarity_keeps_a_motion_the_projections_los
     scolding = act_near("finger_wag", "palm_stop", 0.1)
 
     def chosen(share: float) -> str | None:
-        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=share))
-        return chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), scolding, 0.0)[1]
+        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=share),
+                                 frozenset(CATALOGUE))
+        return chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), scolding, STAY)[1]
 
     assert chosen(0.0) == "palm_stop"
     assert chosen(0.75) == "finger_wag"  # the pretrained cosines still see which description it is near
 
 
 def test_an_empty_library_leaves_the_class_without_a_motion(chooser):
-    assert chooser.choose(lambda: {}, 1, "doubting", proba(doubting=1.0), act_near("shrug"), 2.0) == ("doubting", None)
+    assert chooser.choose(lambda: {}, 1, "doubting", proba(doubting=1.0), act_near("shrug"), MOVE) == ("doubting", None)
 
 
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
@@ -119,7 +140,7 @@ def test_descriptions_are_read_again_when_the_library_changes(chooser):
         return CATALOGUE
 
     for version in (1, 1, 2):
-        chooser.choose(catalogue, version, "doubting", proba(doubting=1.0), act_near("shrug"), 0.0)
+        chooser.choose(catalogue, version, "doubting", proba(doubting=1.0), act_near("shrug"), STAY)
     assert len(calls) == 2
 
 
@@ -135,9 +156,10 @@ def test_projections_learn_the_annotated_motion():
     projections = new_projections(4)
 
     def chosen() -> str | None:
-        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=0.0))
+        chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=0.0),
+                                 frozenset(CATALOGUE))
         act = Features(vector[None], vector[None], vector[None], [NO_WORDS])
-        return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), act, 0.0)[1]
+        return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), act, STAY)[1]
 
     assert chosen() == "chin_stroke"
     acts = [AnnotatedAct("doubting", "shrug", between.clone(), between.clone()) for _ in range(64)]
