@@ -25,8 +25,11 @@ def test_g1_check_runs_one_gesture_and_releases(tmp_path, domain_id, compose):
     require_dds()
     robot = FakeRobot(domain_id, tmp_path / "fake.jsonl", [])
     try:
+        # The fake robot is another process: in one full run on the loaded 2-core machine its state
+        # stream paused 224 ms, over the 200 ms loss limit, and the check faulted as designed. Loss is
+        # tested below and in test_g1_faults.py; here a longer limit keeps the happy path about itself.
         cfg = compose("+experiment=g1_check", "planner=keyword", f"backend.domain_id={domain_id}", *FAST,
-                      "job.gesture=chop_right")
+                      "job.gesture=chop_right", "backend.lowstate_loss_ms=1000")
         results = app.run(cfg, tmp_path)
     finally:
         robot.stop()
