@@ -21,6 +21,7 @@ cached under cache_dir (planners/local_artifact.py).
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass
 
@@ -103,14 +104,15 @@ class LocalPlanner:
     def __init__(self, library: MotionLibrary, train_files: list[str], cache_dir: str, training: dict,
                  min_words: int, temperature: float, boundary_weight: float, act_cost: float, max_records: int,
                  variant_word_weight: float, variant_shared_weight: float, variant_pretrained_share: float,
-                 variant_class_weight: float, variant_class_weight_new: float, history_threshold: float, bf16_inference: bool, trace_inference: bool) -> None:
+                 variant_class_weight: float, variant_class_weight_new: float, history_threshold: float,
+                 bf16_inference: bool, trace_inference: bool) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
         for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
                              ("variant_class_weight", variant_class_weight),
                              ("variant_class_weight_new", variant_class_weight_new)):
-            if not isinstance(weight, int | float) or not weight >= 0:
-                raise ValueError(f"planner.{name} must be a number >= 0 (0 turns it off), got {weight!r}")
+            if not isinstance(weight, int | float) or not 0 <= weight < math.inf:
+                raise ValueError(f"planner.{name} must be a finite number >= 0 (0: no weight), got {weight!r}")
         if not isinstance(variant_pretrained_share, int | float) or not 0 <= variant_pretrained_share <= 1:
             raise ValueError(f"planner.variant_pretrained_share must be a number from 0 to 1, "
                              f"got {variant_pretrained_share!r}")
@@ -133,7 +135,7 @@ class LocalPlanner:
         self.model = LocalInference(load_model(artifact, self.config), self.bf16_inference, self.trace_inference)
         model = self.model.model
         self.variants = VariantChooser(model.variant_projections, self.model.describe, self.variant_weights,
-                                       frozenset(model.trained_motions))
+                                       frozenset(model.annotated_motions))
 
     def retrain(self) -> None:
         """Train again (replacing the cached artifact) and use the new model."""
@@ -174,8 +176,8 @@ class LocalPlanner:
         """The semi-CRF's best split (planners/semi_crf.py): act scores are the class logits / temperature,
         an act starting inside the utterance adds boundary_weight * its boundary logit - act_cost.
         The model is trained with (1, 1, 0); the knobs are for the held-out sweep in train_local.
-        Each act's motion is chosen with its class (planners/local_variants.py), which may move an unsure
-        act to the class of a motion that fits its words clearly better (variant_class_weight, and
+        Each act's motion is chosen with its class (planners/local_variants.py): a motion of another class
+        that fits the act's words better than its own class's may move it (variant_class_weight, and
         variant_class_weight_new for a motion the training data never annotated)."""
         pieces, spans = scored.pieces, scored.spans
         openings = self.boundary_weight * scored.boundaries - self.act_cost

@@ -18,7 +18,7 @@ from emopose.planners.local_data import load_examples
 from emopose.planners.local_model import ActModel
 
 log = logging.getLogger(__name__)
-ARTIFACT_VERSION = 15
+ARTIFACT_VERSION = 16
 
 
 def artifact_path(paths: list[str], cache_dir: str | Path, config: TrainingConfig) -> Path:

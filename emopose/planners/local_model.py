@@ -82,7 +82,7 @@ class ActModel:
         self.act_head, self.boundary_head, self.anchor_head, self.relevance_head = new_heads(width)
         self.variant_projections = new_projections(width)  # (semantic, lexical)
         self.word_frequency = torch.zeros(self.body.config.vocab_size)  # in the training texts (learn_words)
-        self.trained_motions: list[str] = []  # motions the training data annotates (set by training)
+        self.annotated_motions: list[str] = []  # motions the training data annotates (set by training)
 
     @property
     def heads(self) -> list:
@@ -151,7 +151,7 @@ class ActModel:
         top = {f"layer.{i}": self.body.encoder.layer[i].state_dict()
                for i in range(self.frozen_depth, len(self.body.encoder.layer))}
         return {"top": top, "heads": [h.state_dict() for h in self.heads], "config": self.config.model_dump(),
-                "word_frequency": self.word_frequency, "trained_motions": self.trained_motions}
+                "word_frequency": self.word_frequency, "annotated_motions": self.annotated_motions}
 
     def load_state(self, state: dict) -> None:
         for key, weights in state["top"].items():
@@ -159,4 +159,4 @@ class ActModel:
         for head, weights in zip(self.heads, state["heads"], strict=True):
             head.load_state_dict(weights)
         self.word_frequency = state["word_frequency"]
-        self.trained_motions = list(state["trained_motions"])
+        self.annotated_motions = list(state["annotated_motions"])

@@ -83,7 +83,7 @@ def train(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[s
     for p in top.parameters():
         p.requires_grad_(True)
     model.learn_words(sorted({e.text for e in examples}))
-    model.trained_motions = sorted({v for e in examples for v in e.variants if v})
+    model.annotated_motions = sorted({v for e in examples for v in e.variants if v})
     # Batches of inputs with the same token count (history prefix included) are barely padded (sorting
     # by the utterance's characters left a third of every batch padding); their order is shuffled each epoch.
     lengths = model.input_lengths([e.text for e in examples], [e.history for e in examples])

@@ -17,18 +17,18 @@ score(act, motion) = (1 - q) * [cos(Ps a, Ps m) over the semantic vectors + cos(
 
 Ps and Pl start as the identity and are trained on the annotated variants of the training split, each
 on its own similarity, with a random share of each class's motions left out of every batch, so they
-learn what in an utterance points at a description, not which motions the data favours. The two
-untrained terms keep a new motion's own words decisive: a motion added by file is scored like a known
-one, without retraining. Even so the projections lean toward what the annotated data calls each known
-motion; q (pretrained_share), a share of the pretrained encoder's own similarity, keeps part of the dense
-terms free of that. The shared-word term counts only words both texts say, so it adds nothing for
-descriptions that merely sound alike (the averaged distinctive vectors do; leaning on the shared words,
-known motions lose fewer acts to new ones). The projections read only frozen states, so they are
+learn what in an utterance points at a description, not which motions the data favours. The
+untrained word terms (distinctive and shared) keep a new motion's own words decisive: a motion added by
+file is scored like a known one, without retraining. Even so the projections lean toward what the
+annotated data calls each known motion; q (pretrained_share), a share of the pretrained encoder's own
+similarity, keeps part of the dense terms free of that. The shared-word term counts only words both
+texts say, so it adds nothing for descriptions that merely sound alike (the averaged distinctive vectors
+do; leaning on the shared words, known motions lose fewer acts to new ones). The projections read only frozen states, so they are
 trained apart from the encoder, in seconds, after its epochs (planners/local_training.py).
 
-The class is chosen with the motion (VariantChooser.choose): log p(class) + w * (score - the act's mean
-score), so a motion that fits an act's words clearly better can move an act the split model was unsure
-about; w is larger for a motion the training data never annotated, whose uses the class head cannot know.
+The class is chosen with the motion (VariantChooser.choose): a motion of another class that fits the act
+better than its own class's best can move it, by log p(class) + w * (the score margin); w is larger for a
+motion the training data never annotated, whose uses the class head cannot know.
 """
 
 from __future__ import annotations
@@ -92,11 +92,11 @@ class Features:
 
 @dataclass
 class Weights:
-    """How much the untrained terms count in the variant score (conf/planner/local.yaml)."""
+    """How the variant score's terms are weighed (conf/planner/local.yaml)."""
 
     word: float  # the distinctive vectors' cosine
     shared: float  # the share of the act's rarity weight in words the description also uses
-    pretrained_share: float  # of the semantic and lexical cosines, the share taken before the projections
+    pretrained_share: float  # of the semantic and lexical cosines, the share taken of the unprojected vectors
 
 
 def projected(projections, features: Features) -> tuple:
@@ -198,34 +198,36 @@ def fit_variants(projections, acts: list[AnnotatedAct], described: dict[str, tup
 
 @dataclass(frozen=True)
 class ClassMove:
-    """How far a motion that fits an act's words better may move the act's class (conf/planner/local.yaml)."""
+    """How far a motion that fits an act better than its class's own motions may move the act's class
+    (conf/planner/local.yaml)."""
 
-    trained: float  # toward a motion the training data annotates: the class head has read acts about it
+    annotated: float  # toward a motion the training data annotates: the class head has read acts about it
     new: float  # toward one it never saw: the motion's description is the only evidence for its uses
 
 
 class VariantChooser:
     """Inference: an act's class and motion. The descriptions are read and projected once per library
-    version. describe(texts) -> their Features; trained: the motions the training data annotates."""
+    version. describe(texts) -> their Features; annotated: the motions the training data annotates."""
 
     def __init__(self, projections, describe: Callable[[list[str]], Features], weights: Weights,
-                 trained: frozenset[str]) -> None:
-        self.projections, self.describe, self.weights, self.trained = projections, describe, weights, trained
+                 annotated: frozenset[str]) -> None:
+        self.projections, self.describe, self.weights = projections, describe, weights
+        self.annotated = annotated
         self._cached: tuple = (-1, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool), ())
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, str]]], version: int, cls: str,
                proba: np.ndarray, act: Features, move: ClassMove,
                excluded: frozenset[str] = frozenset()) -> tuple[str, str | None]:
-        """(class, motion) for an act the split model reads as cls with class probabilities proba. Each
-        class offers its best-scoring motion m; the class maximising log proba[c] + w(m) * (score(m) - the
-        act's mean score over the library) wins, with that motion. w(m) is move.trained for a motion the
-        training data annotates and move.new for one it never saw: the class head's probabilities already
-        weigh what the data says of a known motion's uses, while for a new one (a "finger wag" added by
-        file, for a scolding the model half read as comforting) the fit is all there is. With both weights
-        0, or when cls has no motion, the class stays cls. Classes in excluded (the neighbouring acts')
-        are never moved to. catalogue() -> the live library's selectable motions, name -> (class,
-        description text), read again when the library's version changes. act: the act's Features (one
-        row)."""
+        """(class, motion) for an act the split model reads as cls with class probabilities proba.
+        Within cls the best-scoring motion is chosen. Another class c moves the act when its best motion
+        m fits by enough more: log proba[c] + w(m) * (score(m) - score of cls's best) > log proba[cls].
+        w(m) is move.annotated for a motion the training data annotates and move.new for one it never
+        saw: the class head's probabilities already weigh what the data says of a known motion's uses,
+        while for a new one (a "finger wag" added by file, for a scolding the model read as comforting)
+        the fit is all there is. A weight of 0 never moves; nor does anything when cls has no motion.
+        Classes in excluded (the neighbouring acts') are never moved to. catalogue() -> the live
+        library's selectable motions, name -> (class, description text), read again when the library's
+        version changes. act: the act's Features (one row)."""
         import torch
 
         cached = self._cached  # one read: another thread may replace it
@@ -235,24 +237,24 @@ class VariantChooser:
                 *vectors, words = projected(self.projections, self.describe([text for _, text in entries.values()]))
                 motions = (*vectors, word_presence(words))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
-            trained = np.array([name in self.trained for name in entries], dtype=bool)
-            cached = self._cached = (version, list(entries), classes, trained, motions)
-        _, names, classes, trained, motions = cached
+            is_annotated = np.array([name in self.annotated for name in entries], dtype=bool)
+            cached = self._cached = (version, list(entries), classes, is_annotated, motions)
+        _, names, classes, is_annotated, motions = cached
         own = CLASSES.index(cls)
-        if not (classes == own).any():
+        members = np.flatnonzero(classes == own)
+        if not len(members):
             return cls, None
         with torch.inference_mode():
             row = scores(projected(self.projections, act), motions, self.weights)[0]
-        fit = row - row.mean()
-        weight = np.where(trained, move.trained, move.new)
-        best_total, best_motion = -np.inf, None
-        # the split model's class first: a tie keeps it
-        for c in [own, *(c for c in set(classes.tolist()) - {own} if CLASSES[c] not in excluded)]:
-            members = np.flatnonzero(classes == c)
+        own_best = members[int(np.argmax(row[members]))]
+        chosen, best_total = own_best, np.log(proba[own] + 1e-12)
+        weight = np.where(is_annotated, move.annotated, move.new)
+        for other in sorted(set(classes.tolist()) - {own} - {CLASSES.index(c) for c in excluded}):
+            members = np.flatnonzero(classes == other)
             m = members[int(np.argmax(row[members]))]
-            if c != own and not weight[m]:
+            if not weight[m]:
                 continue  # no weight, no move (the split may have chosen a less likely class for a reason)
-            total = np.log(proba[c] + 1e-12) + weight[m] * fit[m]
-            if total > best_total:
-                best_total, best_motion = total, m
-        return CLASSES[classes[best_motion]], names[best_motion]
+            total = np.log(proba[other] + 1e-12) + weight[m] * (row[m] - row[own_best])
+            if total > best_total:  # a tie keeps the split model's class
+                chosen, best_total = m, total
+        return CLASSES[classes[chosen]], names[chosen]

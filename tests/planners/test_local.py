@@ -94,9 +94,9 @@ def test_train_local_search_is_checked_before_anything_is_built():
     ("+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
     ("~planner.training.epochs", "epochs\n  Field required"),  # the YAML is the one place of every value
     ("planner.temperature=0", "temperature must be positive"),
-    ("planner.variant_class_weight=-1", "variant_class_weight must be a number >= 0"),
-    ("planner.variant_class_weight_new=-1", "variant_class_weight_new must be a number >= 0"),
-    ("planner.variant_shared_weight=-0.5", "variant_shared_weight must be a number >= 0"),
+    ("planner.variant_class_weight=-1", "variant_class_weight must be a finite number >= 0"),
+    ("planner.variant_class_weight_new=.inf", "variant_class_weight_new must be a finite number >= 0"),
+    ("planner.variant_shared_weight=-0.5", "variant_shared_weight must be a finite number >= 0"),
     ("planner.variant_pretrained_share=1.5", "variant_pretrained_share must be a number from 0 to 1"),
     ("planner.history_threshold=null", "history_threshold must be a number"),
 ])

@@ -87,6 +87,21 @@ def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, 
     assert "<" in err  # tqdm's "elapsed<remaining": the ETA
 
 
+def test_the_model_keeps_which_motions_its_training_data_annotates(model, tmp_path):
+    # the variant choice weighs a motion's fit more when the class head never read an act about it
+    from emopose.planners.local_training import fit
+
+    path = write_jsonl(tmp_path / "train.jsonl", [
+        {"id": "a", "text": "Hi there! The exit is on your left.", "labels": ["welcoming", "pointing"],
+         "anchors": ["Hi there", "on your left"], "variants": ["face_wave", "point_left"]},
+        {"id": "b", "text": "No, don't touch that.", "label": "rejecting"}])
+    fit(model, load_examples([path], 0), {}, progress=False)
+    assert model.annotated_motions == ["face_wave", "point_left"]
+    restored = ActModel(model.config)
+    restored.load_state(model.state())
+    assert restored.annotated_motions == ["face_wave", "point_left"]
+
+
 def test_linear_schedule_warms_up_then_decays_to_zero():
     from emopose.planners.local_training import learning_rate_factor
 

@@ -22,7 +22,7 @@ CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who know
              "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}
 AXIS = {name: k for k, name in enumerate(CATALOGUE)}  # each motion's description is one axis of a 4-D space
 NO_WORDS = (np.zeros(0, dtype=int), np.zeros(0, dtype=np.float32))
-STAY, MOVE = ClassMove(trained=0.0, new=0.0), ClassMove(trained=2.0, new=2.0)
+STAY, MOVE = ClassMove(annotated=0.0, new=0.0), ClassMove(annotated=2.0, new=2.0)
 
 
 def describe(texts: list[str], words: dict[str, tuple] | None = None) -> Features:
@@ -76,12 +76,25 @@ def test_a_motion_the_training_data_never_annotated_moves_the_class_further():
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding, MOVE)[0] == "doubting"
     # the class head was sure without knowing the new motion; its clear fit moves the act all the same
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding,
-                          ClassMove(trained=2.0, new=8.0)) == ("rejecting", "finger_wag")
-    # the larger weight is the new motion's alone: a trained one fitting as well moves no further
+                          ClassMove(annotated=2.0, new=8.0)) == ("rejecting", "finger_wag")
+    # the larger weight is the new motion's alone: an annotated one fitting as well moves no further
     known = VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0),
                            frozenset(CATALOGUE))
     assert known.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding,
-                        ClassMove(trained=2.0, new=8.0))[0] == "doubting"
+                        ClassMove(annotated=2.0, new=8.0))[0] == "doubting"
+    # however large its weight, a new motion that fits no better than the act's own class's never moves it
+    even = act_near("chin_stroke", "finger_wag", 0.5)
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
+                          ClassMove(annotated=2.0, new=8.0))[0] == "doubting"
+
+
+def test_no_weight_no_move_even_toward_a_likelier_class(chooser):
+    # the split may give an act a less likely class (neighbouring acts must differ); a weight of 0 keeps it
+    likelier_elsewhere = proba(doubting=0.4, rejecting=0.6)
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", likelier_elsewhere, act_near("finger_wag"),
+                          STAY) == ("doubting", "chin_stroke")
+    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", likelier_elsewhere, act_near("finger_wag"),
+                          ClassMove(annotated=0.0, new=8.0))[0] == "doubting"  # finger_wag is annotated here
 
 
 def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser):
