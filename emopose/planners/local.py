@@ -108,11 +108,13 @@ class LocalPlanner:
                  bf16_inference: bool, trace_inference: bool) -> None:
         if not temperature > 0:
             raise ValueError(f"planner.temperature must be positive, got {temperature!r}")
-        for name, weight in (("variant_word_weight", variant_word_weight), ("variant_shared_weight", variant_shared_weight),
+        for name, weight in (("variant_word_weight", variant_word_weight),
+                             ("variant_shared_weight", variant_shared_weight),
                              ("variant_class_weight", variant_class_weight),
                              ("variant_class_weight_new", variant_class_weight_new)):
             if not isinstance(weight, int | float) or not 0 <= weight < math.inf:
-                raise ValueError(f"planner.{name} must be a finite number >= 0 (0: no weight), got {weight!r}")
+                raise ValueError(f"planner.{name} must be a finite number >= 0 (0: no weight), "
+                                 f"got {weight!r}")
         if not isinstance(variant_pretrained_share, int | float) or not 0 <= variant_pretrained_share <= 1:
             raise ValueError(f"planner.variant_pretrained_share must be a number from 0 to 1, "
                              f"got {variant_pretrained_share!r}")

@@ -10,7 +10,8 @@ and their tokens with rarity weights (Features):
   the training texts (smooth inverse frequency): "baffled", "thumbs", "floor" count, "I" and "the" do not;
 - words: the token ids with the same rarity weights.
 
-score(act, motion) = (1 - q) * [cos(Ps a, Ps m) over the semantic vectors + cos(Pl a, Pl m) over the lexical ones]
+score(act, motion) = (1 - q) * [cos(Ps a, Ps m) over the semantic vectors
+                              + cos(Pl a, Pl m) over the lexical ones]
                      + q * [cos(a, m) over the semantic vectors + cos(a, m) over the lexical ones]
                      + word_weight * cos(a, m) over the distinctive ones
                      + shared_weight * (share of the act's rarity weight in words the description also uses).
@@ -23,8 +24,9 @@ file is scored like a known one, without retraining. Even so the projections lea
 annotated data calls each known motion; q (pretrained_share), a share of the pretrained encoder's own
 similarity, keeps part of the dense terms free of that. The shared-word term counts only words both
 texts say, so it adds nothing for descriptions that merely sound alike (the averaged distinctive vectors
-do; leaning on the shared words, known motions lose fewer acts to new ones). The projections read only frozen states, so they are
-trained apart from the encoder, in seconds, after its epochs (planners/local_training.py).
+do; leaning on the shared words, known motions lose fewer acts to new ones). The projections read only
+frozen states, so they are trained apart from the encoder, in seconds, after its epochs
+(planners/local_training.py).
 
 The class is chosen with the motion (VariantChooser.choose): a motion of another class that fits the act
 better than its own class's best can move it, by log p(class) + w * (the score margin); w is larger for a
@@ -37,6 +39,7 @@ import random
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -99,14 +102,23 @@ class Weights:
     pretrained_share: float  # of the semantic and lexical cosines, the share taken of the unprojected vectors
 
 
-def projected(projections, features: Features) -> tuple:
-    """(semantic and lexical through their projections, normalised; semantic, lexical, distinctive as
-    read; words): what the score compares (torch)."""
+class Compared(NamedTuple):
+    """What the score compares of N texts (torch vectors)."""
+
+    projected_semantic: object  # (N, D) through the semantic projection, normalised
+    projected_lexical: object  # (N, D) through the lexical projection, normalised
+    semantic: object  # (N, D) as read
+    lexical: object  # (N, D) as read
+    distinctive: object  # (N, D) as read
+    words: object  # acts: per text (token ids, rarity weights); motions: word_presence() of theirs
+
+
+def projected(projections, features: Features) -> Compared:
     import torch
 
     semantic, lexical = torch.from_numpy(features.semantic), torch.from_numpy(features.lexical)
-    return (unit(projections[0], semantic), unit(projections[1], lexical),
-            semantic, lexical, torch.from_numpy(features.distinctive), features.words)
+    return Compared(unit(projections[0], semantic), unit(projections[1], lexical),
+                    semantic, lexical, torch.from_numpy(features.distinctive), features.words)
 
 
 def word_presence(motion_words: list[tuple[np.ndarray, np.ndarray]]) -> np.ndarray:
@@ -126,14 +138,15 @@ def shared_words(words: tuple[np.ndarray, np.ndarray], present: np.ndarray) -> n
     return present[:, ids[known]] @ weights[known] / max(float(weights.sum()), 1e-9)
 
 
-def scores(act: tuple, motions: tuple, weights: Weights) -> np.ndarray:
+def scores(act: Compared, motions: Compared, weights: Weights) -> np.ndarray:
     """(A, M) variant scores of A acts against M motions, both as projected() gives them, with the
     motions' words tabulated by word_presence()."""
-    trained = act[0] @ motions[0].T + act[1] @ motions[1].T
-    pretrained = act[2] @ motions[2].T + act[3] @ motions[3].T
+    trained = (act.projected_semantic @ motions.projected_semantic.T
+               + act.projected_lexical @ motions.projected_lexical.T)
+    pretrained = act.semantic @ motions.semantic.T + act.lexical @ motions.lexical.T
     q = weights.pretrained_share
-    dense = (1 - q) * trained + q * pretrained + weights.word * act[4] @ motions[4].T
-    shared = np.stack([shared_words(words, motions[5]) for words in act[5]])
+    dense = (1 - q) * trained + q * pretrained + weights.word * act.distinctive @ motions.distinctive.T
+    shared = np.stack([shared_words(words, motions.words) for words in act.words])
     return dense.numpy() + weights.shared * shared
 
 
@@ -234,8 +247,8 @@ class VariantChooser:
         if cached[0] != version:
             entries = catalogue()
             with torch.inference_mode():
-                *vectors, words = projected(self.projections, self.describe([text for _, text in entries.values()]))
-                motions = (*vectors, word_presence(words))
+                described = projected(self.projections, self.describe([text for _, text in entries.values()]))
+                motions = described._replace(words=word_presence(described.words))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
             is_annotated = np.array([name in self.annotated for name in entries], dtype=bool)
             cached = self._cached = (version, list(entries), classes, is_annotated, motions)
