@@ -32,15 +32,15 @@ from control_loop import realtime_priority  # benchmarks/ is on sys.path when ru
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
 from emopose.contract import GestureRecord
-from emopose.control_loop import ControlLoop
-from emopose.gesture_command import GestureCommand
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
-from emopose.sequencer import Sequencer
+from emopose.execution.sequencer import Sequencer
 from emopose.stages.modulate import modulate_keyframes
-from emopose.timeline import TimelinePlanner, TimelineSettings
-from emopose.trajectory import TrajectoryBuilder
-from emopose.turn import ModulatedGesture, ResolvedGesture
+from emopose.turn.timeline import TimelinePlanner, TimelineSettings
+from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.turn.model import ModulatedGesture, ResolvedGesture
 
 LIBRARY = Path(__file__).resolve().parents[1] / "library" / "g1"
 

@@ -1,6 +1,6 @@
 """The real 50 Hz control loop in wall time: period error, cumulative drift and missed deadlines.
 
-Runs emopose.control_loop.ControlLoop with the MonotonicClock (absolute deadlines t0 + n dt) for
+Runs emopose.execution.control_loop.ControlLoop with the MonotonicClock (absolute deadlines t0 + n dt) for
 --seconds per backend (dry_run, mujoco), with the sequencer kept busy: a library motion is submitted
 whenever it settles, so trajectory construction happens inside the loop as in a session.
   period error  (actual tick n - actual tick n-1) - dt, where "actual" is when sleep_until returned
@@ -27,11 +27,11 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 from emopose import CONTROL_DT
 from emopose.clock import MonotonicClock
-from emopose.control_loop import ControlLoop
-from emopose.gesture_command import GestureCommand
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.gesture_command import GestureCommand
 from emopose.library import MotionLibrary
-from emopose.sequencer import Sequencer
-from emopose.trajectory import TrajectoryBuilder
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
 
 LIBRARY = Path(__file__).resolve().parents[1] / "library" / "g1"
 

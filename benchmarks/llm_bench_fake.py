@@ -34,7 +34,7 @@ from conftest import load_library, make_library_dir
 from planners.fake_answers import FAULTS, PLAN, UNUSABLE
 
 from emopose.planners.base import PlanRequest, plan_all
-from emopose.planners.llm import LLMPlanner
+from emopose.planners.chat.llm import LLMPlanner
 from emopose.stages.parse import parse_output
 
 FAKE_SERVER = ROOT / "tests" / "planners" / "fake_openai.py"

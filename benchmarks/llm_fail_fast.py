@@ -61,8 +61,8 @@ def prompt_sizes() -> dict:
     from hydra.utils import instantiate
 
     from emopose.planners.base import PlanRequest
-    from emopose.planners.chat import PROBE_LINE
-    from emopose.planners.llm_check import prompt_tokens
+    from emopose.planners.chat.planner import PROBE_LINE
+    from emopose.llm.check import prompt_tokens
 
     register_resolvers()
     sizes = {}

@@ -28,7 +28,7 @@ from conftest import load_library, make_library_dir
 from fake_openai import Answer, FakeOpenAI, slow
 
 from emopose.planners.base import PlanRequest, plan_all
-from emopose.planners.llm import LLMPlanner
+from emopose.planners.chat.llm import LLMPlanner
 
 
 def echo(body: dict, index: int) -> Answer:

@@ -24,7 +24,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from emopose.bench.suites import load_bench
 from emopose.planners.base import PlanRequest, plan_all
-from emopose.planners.sbert_centroids import SbertCentroidPlanner
+from emopose.planners.baselines.sbert_centroids import SbertCentroidPlanner
 
 BENCH = ROOT / "experiments/bench/emopose_bench.jsonl"
 TARGET_S = 3.0

@@ -35,7 +35,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 from conftest import compose_config
 
 from emopose.build import build_run
-from emopose.planners.keyword import KeywordPlanner
+from emopose.planners.baselines.keyword import KeywordPlanner
 
 FAKE_SERVER = ROOT / "tests" / "planners" / "fake_openai.py"
 REPLY = ("Hello, visitor {n}, welcome to the lab! The charging dock is over there, by the window. "

@@ -13,7 +13,7 @@ from pathlib import Path
 from omegaconf import DictConfig
 
 from emopose.build import build_job, build_run
-from emopose.jobs.report import write_results
+from emopose.results import write_results
 from emopose.stop_signals import signal_name
 
 log = logging.getLogger(__name__)

@@ -18,15 +18,14 @@ from hydra.utils import get_class, instantiate
 from omegaconf import DictConfig, OmegaConf
 
 from emopose.clock import FakeClock, MonotonicClock
-from emopose.control_loop import ControlLoop
-from emopose.pipeline import Pipeline, PipelineError
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.resources import Resources, Run
-from emopose.runner import TurnRunner
-from emopose.session import Session
+from emopose.scene.view import SceneSlot
 from emopose.speech.player import Player
-from emopose.sync_record import event_writer
-from emopose.tour.scene_view import SceneSlot
-from emopose.trajectory import TrajectoryBuilder
+from emopose.turn.pipeline import Pipeline, PipelineError
+from emopose.turn.runner import TurnRunner
+from emopose.turn.session import Session
 
 
 class ConfigError(ValueError):
@@ -123,7 +122,7 @@ def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
                           sequencer=sequencer, clock=clock, synthesizer=synthesizer, player=player,
                           asr=make(cfg.get("asr"), "asr"), scene=scene, run_dir=Path(run_dir))
     session = Session(backend, loop, library.neutral_entry.q[0], run_dir, record=bool(cfg.run.record))
-    sequencer.on_event = event_writer(loop, session.write)
+    sequencer.on_event = session.record_event
     thinking = make_with(cfg.get("thinking"), "thinking", shared)
     return Run(resources, session, TurnRunner(planner, pipeline, session, thinking))
 

@@ -28,6 +28,14 @@ USABLE_SOURCES = frozenset({"model", "retried", "scripted"})
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
 
 
+def trigger_position(reply: str, trigger: str | None) -> int | None:
+    """Where a record's trigger starts in the reply (case-insensitive, first occurrence), or None."""
+    if not trigger:
+        return None
+    pos = reply.lower().find(trigger.lower())
+    return pos if pos >= 0 else None
+
+
 class GestureRecord(BaseModel):
     """One semantic record z_k = (class, variant, intensity, trigger, confidence) (paper Eq. record)."""
 

@@ -11,16 +11,16 @@ from pathlib import Path
 
 from emopose.backends.base import Backend
 from emopose.clock import Clock
+from emopose.execution.sequencer import Sequencer
 from emopose.library import MotionLibrary
-from emopose.pipeline import Pipeline
 from emopose.planners.base import Planner
-from emopose.runner import TurnRunner
-from emopose.sequencer import Sequencer
-from emopose.session import Session
+from emopose.scene.view import SceneSlot
 from emopose.speech.asr import Recognizer
 from emopose.speech.clip import Synthesizer
 from emopose.speech.player import Player
-from emopose.tour.scene_view import SceneSlot
+from emopose.turn.pipeline import Pipeline
+from emopose.turn.runner import TurnRunner
+from emopose.turn.session import Session
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from emopose.build import build_run, ordered_stages
 from emopose.config import CONFIG_DIR
-from emopose.planners.prompting import load_demonstrations
+from emopose.planners.chat.prompting import load_demonstrations
 from tests.conftest import compose_config
 
 DEFAULTS = {group: option for entry in OmegaConf.load(CONFIG_DIR / "config.yaml").defaults

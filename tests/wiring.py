@@ -7,12 +7,10 @@ from dataclasses import dataclass
 
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
-from emopose.control_loop import ControlLoop
-from emopose.pipeline import Pipeline
-from emopose.planners.keyword import KeywordPlanner
-from emopose.runner import TurnRunner
-from emopose.sequencer import Sequencer
-from emopose.session import Session
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.planners.baselines.keyword import KeywordPlanner
 from emopose.speech.clip import EstimatedSpeech
 from emopose.speech.player import Player
 from emopose.stages.dispatch import Dispatch
@@ -21,7 +19,9 @@ from emopose.stages.parse import Parse
 from emopose.stages.resolve import Resolve
 from emopose.stages.schedule import ScheduleStage
 from emopose.stages.sequence import SequenceStage
-from emopose.trajectory import TrajectoryBuilder
+from emopose.turn.pipeline import Pipeline
+from emopose.turn.runner import TurnRunner
+from emopose.turn.session import Session
 
 
 @dataclass

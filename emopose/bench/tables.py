@@ -3,7 +3,7 @@
 Each results dict carries "kind" (bench | context_ablation | sequence_suite) and "method" (planner
 name); an optional "label" names the row (e.g. a sweep job's overrides). Cells read "ours (paper)";
 methods the paper reports but we did not run are listed as paper-only reference rows. Used by the jobs'
-results.md, the sweep callback and `python -m emopose.bench.report`.
+results.md, the sweep callback and `python -m emopose.report`.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from emopose.bench.paper import PAPER_CONTEXT, PAPER_METHOD_NAMES, PAPER_SEMANTIC, PAPER_SEQUENCE
-from emopose.jobs.report import markdown_table
+from emopose.results import markdown_table
 
 TIER_KEYS = ("easy", "medium", "hard", "overall")
 CONTEXT_KEYS = ("with_history", "without_history", "gain")

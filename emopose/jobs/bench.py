@@ -15,7 +15,6 @@ from emopose.bench.confusion import ABBREVIATIONS, ConfusionPanel, confusion_cou
 from emopose.bench.metrics import accuracy, by_pass, tier_accuracy
 from emopose.bench.suites import TIERS, load_bench
 from emopose.bench.tables import comparison_markdown, fmt
-from emopose.jobs.report import write_results
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     check_fallback_share,
@@ -25,6 +24,7 @@ from emopose.jobs.suite_planning import (
 )
 from emopose.planners.base import PlanRequest
 from emopose.resources import Resources, Run
+from emopose.results import write_results
 
 
 @dataclass

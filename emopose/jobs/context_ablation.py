@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from emopose.bench.metrics import paired_context_accuracy
 from emopose.bench.suites import load_context
 from emopose.bench.tables import comparison_markdown
-from emopose.jobs.report import write_results
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     check_fallback_share,
@@ -23,6 +22,7 @@ from emopose.jobs.suite_planning import (
 )
 from emopose.planners.base import PlanRequest
 from emopose.resources import Run
+from emopose.results import write_results
 
 
 @dataclass

@@ -16,8 +16,8 @@ import numpy as np
 
 from emopose.backends.g1.errors import G1BackendError
 from emopose.contract import GestureRecord, Plan
-from emopose.jobs.report import write_results
 from emopose.resources import Run
+from emopose.results import write_results
 
 
 @dataclass

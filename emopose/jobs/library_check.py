@@ -19,9 +19,9 @@ import numpy as np
 from emopose import CONTROL_DT
 from emopose.backends.capabilities import Renderable, SimulatedState
 from emopose.jobs.contact_sheet import render_keyframes, render_pose, write_overview, write_sheet
-from emopose.jobs.report import markdown_table, write_results
 from emopose.jobs.tracking import StreamTap, tracking_error
 from emopose.resources import Resources, Run
+from emopose.results import markdown_table, write_results
 from emopose.robot.collision import SelfCollisionChecker
 from emopose.stages.modulate import Modulate
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from emopose.jobs.report import markdown_table, write_results
 from emopose.resources import Run
+from emopose.results import markdown_table, write_results
 
 
 @dataclass

@@ -16,10 +16,10 @@ import numpy as np
 from emopose import CONTROL_DT, NUM_JOINTS
 from emopose.backends.capabilities import SimulatedState
 from emopose.jobs.contact_sheet import view
-from emopose.jobs.report import write_results
 from emopose.jobs.tracking import StreamTap, tracking_error
 from emopose.recording import Recorder, read_recording
 from emopose.resources import Run
+from emopose.results import write_results
 
 
 def command_grid(rows: list[tuple[float, dict]], dt: float = CONTROL_DT) -> tuple[np.ndarray, np.ndarray]:

@@ -15,7 +15,6 @@ from emopose.bench.metrics import aggregate_passes
 from emopose.bench.sequence_metrics import SequencePrediction, suite_scores
 from emopose.bench.suites import load_sequence
 from emopose.bench.tables import comparison_markdown
-from emopose.jobs.report import write_results
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     PlannedItem,
@@ -26,6 +25,7 @@ from emopose.jobs.suite_planning import (
 )
 from emopose.planners.base import PlanRequest
 from emopose.resources import Run
+from emopose.results import write_results
 
 COUNT_KEYS = ("over", "under", "failed")
 

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 from emopose.build import ConfigError
 from emopose.clock import MonotonicClock
-from emopose.jobs.report import write_results
 from emopose.resources import Run
+from emopose.results import write_results
 from emopose.web.settings import ServeSettings
 
 log = logging.getLogger(__name__)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 
 from emopose import CLASSES
-from emopose.jobs.report import markdown_table
+from emopose.results import markdown_table
 
 # Paper, Table execution (MuJoCo trajectory-execution results).
 PAPER = {

@@ -23,12 +23,12 @@ import numpy as np
 from emopose import CLASSES
 from emopose.backends.capabilities import SimulatedState
 from emopose.contract import GestureRecord, Plan
-from emopose.jobs.report import write_results
+from emopose.execution.sequencer import State
 from emopose.jobs.sim_report import suite_markdown
 from emopose.jobs.tracking import StreamTap, latency_ms, sim_mae, tracking_error
 from emopose.resources import Run
+from emopose.results import write_results
 from emopose.robot.arm_law import ArmLaw
-from emopose.sequencer import State
 
 log = logging.getLogger(__name__)
 START_MODES = ("alternate", "previous", "rest")

@@ -9,7 +9,7 @@ every released gesture is compared with the onset espeak reports for its trigger
   actual vs onset:    the sequencer's "started" event (what the robot did): the 50 Hz tick grid adds
                       0..20 ms, and a gesture whose predecessor is still running waits for it to end
                       (plus the <= 0.3 s blend), which no schedule can undo.
-  stroke vs onset:    where the executed stroke lands (emopose.stroke_sync.py): the first tick
+  stroke vs onset:    where the executed stroke lands (emopose.sync.strokes.py): the first tick
                       at which the command stream, and with a simulator the joint stream, reaches the
                       gesture's stroke-start keyframe; this is the measure the timeline mode is built for.
 A few items per mode are drawn as timelines (words, planned and executed strokes) into the run directory.
@@ -24,15 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from emopose.clock import FakeClock
-from emopose.jobs.report import markdown_table, write_results
-from emopose.jobs.sync_measure import GestureSync, SuiteItem, load_suite, measure_turn, summarize
-from emopose.jobs.sync_plot import plot_timelines
 from emopose.jobs.tracking import StreamTap
-from emopose.pipeline import Pipeline
 from emopose.resources import Resources, Run
-from emopose.runner import TurnRunner
+from emopose.results import markdown_table, write_results
 from emopose.speech.espeak import EspeakSynthesizer
-from emopose.stroke_sync import (
+from emopose.sync.plot import plot_timelines
+from emopose.sync.strokes import (
     Streams,
     StrokeSync,
     measure_strokes,
@@ -40,6 +37,9 @@ from emopose.stroke_sync import (
     stroke_summary,
     unmet_targets,
 )
+from emopose.sync.words import GestureSync, SuiteItem, load_suite, measure_turn, summarize
+from emopose.turn.pipeline import Pipeline
+from emopose.turn.runner import TurnRunner
 
 log = logging.getLogger(__name__)
 

@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 from emopose.bench.sequence_metrics import SequencePrediction, item_scores
 from emopose.bench.suites import SequenceItem
-from emopose.jobs.report import markdown_table, write_results
-from emopose.planners.local import LocalPlanner, ScoredUtterance, trigger_span
-from emopose.planners.local_data import Example, load_examples
+from emopose.planners.local.data import Example, load_examples
+from emopose.planners.local.planner import LocalPlanner, ScoredUtterance, trigger_span
 from emopose.resources import Run
+from emopose.results import markdown_table, write_results
 
 SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
 

@@ -1,1 +1,1 @@
-"""Semantic planners: one file per family, one YAML per option under conf/planner/."""
+"""Semantic planners, one folder per family (local/, chat/, baselines/); one YAML per option under conf/planner/."""

@@ -11,6 +11,7 @@ import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import Protocol, runtime_checkable
 
 
@@ -51,18 +52,49 @@ class PlannerFailure(RuntimeError):
     instead of reporting keyword fallbacks as the planner's score."""
 
 
+class PlannerMode(StrEnum):
+    """Who writes the words the robot says: the planner (respond) or the caller (narrate: the utterance)."""
+
+    RESPOND = "respond"
+    NARRATE = "narrate"
+
+
 @runtime_checkable
 class Planner(Protocol):
+    """name: shown in results; sampled: answers vary between passes (suites then run 5 passes)."""
+
     name: str
+    sampled: bool
 
     def plan(self, request: PlanRequest) -> PlannerOutput: ...
 
 
+@runtime_checkable
+class CheckedPlanner(Protocol):
+    """A planner that calls a service checks it (key, model string, endpoint) before any run starts;
+    `check()` raises ValueError naming what is missing."""
+
+    def check(self) -> None: ...
+
+
+@runtime_checkable
+class BatchPlanner(Protocol):
+    """A planner that plans many requests concurrently (LLM calls)."""
+
+    def plan_many(self, requests: Sequence[PlanRequest]) -> list[PlannerOutput]: ...
+
+
+@runtime_checkable
+class ModalPlanner(Protocol):
+    """A planner whose mode is configurable (PlannerMode)."""
+
+    mode: PlannerMode
+
+
 def plan_all(planner: Planner, requests: Sequence[PlanRequest]) -> list[PlannerOutput]:
-    """Plan many requests; planners with a concurrent `plan_many` use it (LLM calls), others loop."""
-    batch = getattr(planner, "plan_many", None)
-    if batch is not None:
-        return list(batch(requests))
+    """Plan many requests: concurrently where the planner can, one by one otherwise."""
+    if isinstance(planner, BatchPlanner):
+        return list(planner.plan_many(requests))
     return [planner.plan(r) for r in requests]
 
 

@@ -12,7 +12,7 @@ import time
 from abc import ABC, abstractmethod
 from pathlib import Path
 
-from emopose.planners.llm_client import effective_api_key
+from emopose.llm.client import effective_api_key
 
 log = logging.getLogger(__name__)
 

@@ -14,7 +14,7 @@ import logging
 import re
 from pathlib import Path
 
-from emopose.planners.llm_client import effective_api_key
+from emopose.llm.client import effective_api_key
 from emopose.speech.clip import SpeechClip, WordTiming
 from emopose.speech.espeak import EspeakSynthesizer
 from emopose.speech.espeak_lib import EspeakUnavailable

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from emopose.control_loop import ControlLoop
-from emopose.sequencer import State
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.sequencer import State
 from emopose.speech.player import Player
-from emopose.turn import DispatchReport, Turn
+from emopose.turn.model import DispatchReport, Turn
 
 UNTIL = ("settle", "rest", "none")
 

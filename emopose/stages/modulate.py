@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from emopose.library import JointLimits
-from emopose.turn import ModulatedGesture, ResolvedGesture, Turn
+from emopose.turn.model import ModulatedGesture, ResolvedGesture, Turn
 
 INTENSITY_GAINS = (0.4, 0.6, 1.0, 1.3, 1.6)
 LIMIT_MARGIN = 0.02

@@ -18,8 +18,8 @@ from typing import Any
 from emopose import CLASSES
 from emopose.contract import GestureRecord, Plan
 from emopose.planners.base import PlannerOutput
-from emopose.planners.keyword import keyword_records
-from emopose.turn import Turn
+from emopose.planners.baselines.keyword import keyword_records
+from emopose.turn.model import Turn
 
 log = logging.getLogger(__name__)
 

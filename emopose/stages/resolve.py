@@ -14,7 +14,7 @@ from typing import Literal
 
 from emopose.contract import GestureRecord
 from emopose.library import MotionLibrary
-from emopose.turn import ResolvedGesture, Turn
+from emopose.turn.model import ResolvedGesture, Turn
 
 log = logging.getLogger(__name__)
 

@@ -7,7 +7,7 @@ neighbours); if no trigger matches, release k is at T_a (k + 1/2) / M_g, and a l
 released at once. words mode uses the synthesizer's true onset of the trigger's first word and falls
 back to the anchor equation where it has no word timings. Trigger search is case-insensitive.
 timeline mode (the default, beyond the paper) takes the words-mode times as the onsets the strokes must
-meet and plans every gesture's keyframe times around them (emopose/timeline.py); its release is the
+meet and plans every gesture's keyframe times around them (emopose/turn/timeline.py); its release is the
 gesture's start, possibly before the speech (the pre-roll); the sequencer's published pose tells it
 where the arm is, so a first gesture that starts away from rest still lands on its word.
 """
@@ -21,23 +21,17 @@ from typing import Literal
 
 import numpy as np
 
+from emopose.contract import trigger_position
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.library import JointLimits
-from emopose.sequencer import Sequencer
 from emopose.speech.clip import SpeechClip, Synthesizer
-from emopose.timeline import TimelinePlanner, TimelineSettings
-from emopose.trajectory import TrajectoryBuilder
-from emopose.turn import Release, ReleaseRule, Schedule, Turn
+from emopose.turn.model import Release, ReleaseRule, Schedule, Turn
+from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 
 MODES = ("anchor", "words", "timeline")
 
 log = logging.getLogger(__name__)
-
-def trigger_position(reply: str, trigger: str | None) -> int | None:
-    if not trigger:
-        return None
-    pos = reply.lower().find(trigger.lower())
-    return pos if pos >= 0 else None
-
 
 def anchor_release_times(reply: str, triggers: list[str | None], duration_s: float) -> list[tuple[float, ReleaseRule]]:
     """The paper's schedule equation with its interpolation and even-spacing rules."""

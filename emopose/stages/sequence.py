@@ -17,10 +17,10 @@ import time
 from dataclasses import dataclass, field
 
 from emopose.clock import Clock
-from emopose.gesture_command import GestureCommand
-from emopose.sequencer import Sequencer
+from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.sequencer import Sequencer
 from emopose.speech.player import Player
-from emopose.turn import ModulatedGesture, Release, Submission, Turn
+from emopose.turn.model import ModulatedGesture, Release, Submission, Turn
 
 
 @dataclass

@@ -17,10 +17,10 @@ import numpy as np
 from pydantic import ValidationError
 
 from emopose.contract import LibraryEntry
+from emopose.execution.trajectory import Trajectory, TrajectoryBuilder
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
 from emopose.stages.modulate import Modulate
-from emopose.trajectory import Trajectory, TrajectoryBuilder
 
 LEVELS = (1, 2, 3, 4, 5)
 NOMINAL_LEVEL = 3  # the library sequence as authored: the preview's default level

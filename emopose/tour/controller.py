@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from emopose.robot.g1_spec import CONTROL_DT
-from emopose.tour.geometry import Pose2D, wrap_angle
+from emopose.scene.geometry import Pose2D, wrap_angle
 
 Phase = Literal["turn", "drive", "align", "done"]
 

@@ -13,7 +13,7 @@ import math
 import time
 from collections.abc import Callable
 
-from emopose.tour.geometry import Pose2D, wrap_angle
+from emopose.scene.geometry import Pose2D, wrap_angle
 
 
 class G1Base:

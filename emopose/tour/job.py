@@ -16,15 +16,16 @@ from emopose.backends.base import Backend
 from emopose.backends.capabilities import PlanarBase, SimulatedState
 from emopose.backends.g1.backend import G1Backend
 from emopose.clock import FakeClock
-from emopose.jobs.report import write_results
 from emopose.library import MotionLibrary
 from emopose.planners.base import Planner
 from emopose.resources import Run
+from emopose.results import write_results
 from emopose.tour.camera import camera_for
 from emopose.tour.g1_base import G1Base
 from emopose.tour.navigator import MobileBase
 from emopose.tour.runner import TourRunner
-from emopose.tour.scenario import TourConfigError, TourSpec, load_tour, parse_tour
+from emopose.tour.scenario import TourConfigError, TourSpec
+from emopose.tour.scenario_loading import load_tour, parse_tour
 from emopose.tour.sim_base import MujocoBase
 from emopose.tour.sim_scene import install_scene
 
@@ -94,7 +95,7 @@ class TourJob:
 
         if not self.g1_odometry:
             raise TourConfigError("the tour on the G1 walks on onboard odometry: set job.g1_odometry to a "
-                                  "factory (loco, backend) -> callable returning emopose.tour.geometry.Pose2D")
+                                  "factory (loco, backend) -> callable returning emopose.scene.geometry.Pose2D")
         settings = backend.settings
         loco = LocoClient(domain_id=settings.domain_id, network_interface=settings.network_interface,
                           max_vx=spec.navigation.max_vx, max_omega=spec.navigation.max_wz).open()

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 from emopose import CONTROL_DT
+from emopose.scene.geometry import Pose2D
 from emopose.tour.controller import GoToPose
-from emopose.tour.geometry import Pose2D
 
 
 @runtime_checkable

@@ -18,17 +18,18 @@ import numpy as np
 
 from emopose.backends.capabilities import PlanarBase, SimulatedState
 from emopose.contract import LibraryEntry
-from emopose.gesture_command import GestureCommand
-from emopose.jobs.report import markdown_table, write_results
+from emopose.execution.gesture_command import GestureCommand
 from emopose.resources import Run
+from emopose.results import markdown_table, write_results
 from emopose.robot.kinematics import HAND_ORIGIN
-from emopose.session import Session
-from emopose.tour.aim import AimStage, peak_indices
-from emopose.tour.geometry import Pose2D, angle_between, map_to_torso, torso_to_map
-from emopose.tour.pointing_ik import pointing_error
-from emopose.tour.scenario import TourConfigError, load_tour, parse_tour
+from emopose.robot.pointing_ik import pointing_error
+from emopose.scene.geometry import Pose2D, angle_between, map_to_torso, torso_to_map
+from emopose.stages.aim import AimStage, peak_indices
+from emopose.tour.scenario import TourConfigError
+from emopose.tour.scenario_loading import load_tour, parse_tour
 from emopose.tour.sim_base import MujocoBase
 from emopose.tour.sim_scene import install_scene
+from emopose.turn.session import Session
 
 SHOULDER_HEIGHT = 0.24  # probes are centred about shoulder height above the torso origin
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import asdict, dataclass, field
 
-from emopose.jobs.report import markdown_table
+from emopose.results import markdown_table
 
 
 @dataclass

@@ -17,12 +17,12 @@ from functools import partial
 
 from emopose.planners.base import Planner
 from emopose.resources import Run
+from emopose.scene.view import SceneView
 from emopose.tour.camera import Camera
 from emopose.tour.interruptions import Interruptions, Question, asks_about_scene, wants_abort
 from emopose.tour.navigator import GroundTruthBase, MobileBase, NavigationSettings, Navigator
 from emopose.tour.report import Exchange, StopResult, TourReport
 from emopose.tour.scenario import StopSpec, TourSpec
-from emopose.tour.scene_view import SceneView
 from emopose.tour.voice import Line, TourVoice, sentence_chunks
 from emopose.tour.world import TourWorld
 

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from emopose.tour.geometry import box_clearance, segment_clearance
+from emopose.scene.geometry import box_clearance, segment_clearance
 
 if TYPE_CHECKING:
     from emopose.tour.scenario import TourSpec

@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from emopose.backends.capabilities import PlanarBase
-from emopose.tour.geometry import Pose2D, wrap_angle
+from emopose.scene.geometry import Pose2D, wrap_angle
 
 
 class MujocoBase:

@@ -13,14 +13,14 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from emopose.execution.sequencer import Sequencer, State
 from emopose.planners.base import Planner
-from emopose.runner import TurnRunner
-from emopose.sequencer import Sequencer, State
 from emopose.speech.clip import SpeechClip, Synthesizer
 from emopose.speech.player import Player
 from emopose.tour.interruptions import Question
 from emopose.tour.world import TourWorld
-from emopose.turn import Turn
+from emopose.turn.model import Turn
+from emopose.turn.runner import TurnRunner
 
 _SENTENCE_END = re.compile(r"[.!?]+[\"')\]]*\s+")
 # The parse stage keeps at most 200 characters of a model's reply (stages/parse.py, _text), so a

@@ -12,8 +12,8 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from emopose.clock import Clock
-from emopose.session import Session
 from emopose.tour.navigator import GroundTruthBase, MobileBase
+from emopose.turn.session import Session
 
 
 class TourWorld:

@@ -25,7 +25,7 @@ from emopose.backends.capabilities import SimulatedState
 from emopose.contract import GestureRecord, LibraryEntry, Plan
 from emopose.resources import Run
 from emopose.studio.authoring import PoseStudio
-from emopose.turn import ResolvedGesture, Turn
+from emopose.turn.model import ResolvedGesture, Turn
 from emopose.web.settings import ServeSettings
 from emopose.web.stick_figure import stick_figure
 from emopose.web.turns import outcome_of, summarize_turn

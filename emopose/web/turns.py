@@ -16,8 +16,8 @@ the turn is published before its gestures start, so the session adds outcomes th
 
 from __future__ import annotations
 
-from emopose.stages.schedule import trigger_position
-from emopose.turn import Turn
+from emopose.contract import trigger_position
+from emopose.turn.model import Turn
 
 NOT_PERFORMED = ("rejected", "dropped")  # sequencer event kinds that mean "this gesture did not run"
 

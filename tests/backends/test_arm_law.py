@@ -10,10 +10,10 @@ from emopose import CONTROL_DT
 from emopose.backends.g1.arm_command import ArmCommandBuilder, decode_arm_command
 from emopose.backends.g1.wire import lowcmd_from_cdr
 from emopose.backends.mujoco import MujocoBackend
+from emopose.execution.trajectory import smoothstep
 from emopose.robot.arm_law import ArmLaw
 from emopose.robot.feedforward import MAX_VELOCITY_REFERENCE, Feedforward, GravityModel
-from emopose.stroke_sync import first_within
-from emopose.trajectory import smoothstep
+from emopose.sync.strokes import first_within
 
 ROBOT_PLAIN = ArmLaw("robot_plain", 60.0, 1.5)
 ROBOT_GRAVITY = ArmLaw("robot_gravity", 60.0, 1.5, gravity_compensation=True)

@@ -10,7 +10,7 @@ import pytest
 from emopose.bench.suites import SuiteError
 from emopose.jobs.bench import BenchJob
 from emopose.planners.base import PlannerOutput
-from emopose.planners.keyword import KeywordPlanner
+from emopose.planners.baselines.keyword import KeywordPlanner
 
 FIXTURES = Path(__file__).parent / "fixtures"
 BENCH = f"bench.path={FIXTURES / 'bench_small.jsonl'}"

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from emopose.bench.report import build_report
 from emopose.bench.sweep_callback import collect_results, write_sweep_table
 from emopose.config import PROJECT_ROOT
+from emopose.report import build_report
 
 FIXTURES = Path(__file__).parent / "fixtures"
 

@@ -3,7 +3,7 @@ import pytest
 from emopose.contract import GestureRecord
 from emopose.library import MotionLibrary
 from emopose.stages.modulate import modulate_keyframes
-from emopose.turn import ModulatedGesture, ResolvedGesture
+from emopose.turn.model import ModulatedGesture, ResolvedGesture
 from tests.wiring import wire
 
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from emopose.bounded_log import BoundedLog
-from emopose.gesture_command import GestureCommand
-from emopose.sequencer import Sequencer
-from emopose.trajectory import TrajectoryBuilder
+from emopose.execution.bounded_log import BoundedLog
+from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
 
 
 def test_the_event_log_stays_bounded_and_cursors_still_work(g1):

@@ -9,9 +9,9 @@ import pytest
 from emopose import CONTROL_DT
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
-from emopose.control_loop import ControlLoop, LoopStats
-from emopose.sequencer import Sequencer
-from emopose.trajectory import TrajectoryBuilder
+from emopose.execution.control_loop import ControlLoop, LoopStats
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
 
 
 class SleepyClock(FakeClock):

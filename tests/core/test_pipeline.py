@@ -1,10 +1,10 @@
 import pytest
 
 from emopose.contract import GestureRecord, Plan
-from emopose.pipeline import Pipeline, PipelineError
 from emopose.planners.base import PlanRequest
 from emopose.recording import read_recording
-from emopose.turn import Turn
+from emopose.turn.model import Turn
+from emopose.turn.pipeline import Pipeline, PipelineError
 
 
 def test_misordered_or_ablated_pipeline_is_refused_before_any_model_call(wired):

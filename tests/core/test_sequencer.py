@@ -7,10 +7,10 @@ import pytest
 
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
-from emopose.control_loop import ControlLoop
-from emopose.gesture_command import GestureCommand
-from emopose.sequencer import Sequencer, State
-from emopose.trajectory import TrajectoryBuilder
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.sequencer import Sequencer, State
+from emopose.execution.trajectory import TrajectoryBuilder
 
 
 def command(library, name, release_at=float("-inf")):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from emopose.stroke_sync import StrokeSync, stroke_summary
+from emopose.sync.strokes import StrokeSync, stroke_summary
 
 
 def stroke(k: int, onset: float, executed: float | None, dropped: str | None = None) -> StrokeSync:

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.library import MotionLibrary
-from emopose.timeline import TimelinePlanner, TimelineSettings
-from emopose.trajectory import TrajectoryBuilder
+from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 from tests.core.conftest import gesture
 
 

@@ -10,13 +10,13 @@ from hypothesis import strategies as st
 
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
-from emopose.control_loop import ControlLoop
-from emopose.gesture_command import GestureCommand
-from emopose.sequencer import Sequencer, State
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.sequencer import Sequencer, State
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.stages.sequence import SequenceStage
-from emopose.timeline import TimelinePlanner, TimelineSettings
-from emopose.trajectory import TrajectoryBuilder
-from emopose.turn import Release
+from emopose.turn.model import Release
+from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 from tests.core.conftest import gesture
 
 NAMES = ("point_forward_right", "palm_stop", "chop_right", "face_wave", "shrug", "open_arms", "beat_both_hands",

@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from emopose.trajectory import TrajectoryBuilder, blend_weight, smoothstep
+from emopose.execution.trajectory import TrajectoryBuilder, blend_weight, smoothstep
 
 
 def test_smoothstep_and_blend_curves():

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from emopose.trajectory import TrajectoryBuilder
+from emopose.execution.trajectory import TrajectoryBuilder
 
 
 def reference(builder: TrajectoryBuilder, keyframes, duration, q_last):

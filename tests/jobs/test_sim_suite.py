@@ -11,10 +11,10 @@ from emopose import CLASSES, CONTROL_DT
 from emopose.app import run
 from emopose.backends.mujoco import MujocoBackend
 from emopose.build import make
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.jobs.sim_suite import SimSuiteJob
 from emopose.jobs.tracking import StreamTap, tracking_error
 from emopose.recording import read_recording
-from emopose.trajectory import TrajectoryBuilder
 from tests.jobs.sim_helpers import compose_config
 
 TRACKING_BOUND_RAD = 0.010  # the suite's MAE target, per class default at level 3, under the MJCF's servos

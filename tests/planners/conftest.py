@@ -55,7 +55,7 @@ def planner_kwargs(fake_openai: FakeOpenAI, demonstrations_file: Path, tmp_path:
 
 @pytest.fixture
 def make_llm_planner(writable_library, planner_kwargs) -> Callable:
-    from emopose.planners.llm import LLMPlanner
+    from emopose.planners.chat.llm import LLMPlanner
 
     def make(**overrides):
         kwargs = {**planner_kwargs, "template": str(PROJECT_ROOT / "prompts/structured.md"), **overrides}
@@ -66,7 +66,7 @@ def make_llm_planner(writable_library, planner_kwargs) -> Callable:
 
 @pytest.fixture
 def make_label_planner(writable_library, planner_kwargs) -> Callable:
-    from emopose.planners.direct_label import DirectLabelPlanner
+    from emopose.planners.chat.direct_label import DirectLabelPlanner
 
     def make(**overrides):
         kwargs = {**planner_kwargs, "template": str(PROJECT_ROOT / "prompts/direct_label.md"), **overrides}

@@ -14,7 +14,7 @@ def training_config(**changes):
     """conf/planner/local.yaml's training settings (the one place they live), with changes."""
     from omegaconf import OmegaConf
 
-    from emopose.planners.local_config import TrainingConfig
+    from emopose.planners.local.config import TrainingConfig
     from tests.conftest import compose_config
 
     return TrainingConfig(**{**OmegaConf.to_container(compose_config(["planner=local"]).planner.training,

@@ -9,9 +9,9 @@ import pytest
 from fake_answers import http_error, ok
 
 from emopose.config import PROJECT_ROOT
-from emopose.planners.annotate import AnnotatePlanner
 from emopose.planners.base import PlanRequest
-from emopose.planners.keyword import KeywordPlanner
+from emopose.planners.baselines.keyword import KeywordPlanner
+from emopose.planners.chat.annotate import AnnotatePlanner
 from emopose.stages.parse import parse_output
 
 QUESTION = PlanRequest("Where can I charge my phone?", history=({"role": "user", "content": "Hi!"},
@@ -72,5 +72,5 @@ def test_no_reply_is_a_counted_fallback(fake_openai, make_annotate, answer, sour
 
 def test_the_preset_composes_with_the_local_annotator(compose):
     planner = compose("planner=annotate").planner
-    assert planner.annotator._target_ == "emopose.planners.local.LocalPlanner" and planner.annotator._partial_
+    assert planner.annotator._target_ == "emopose.planners.local.planner.LocalPlanner" and planner.annotator._partial_
     assert planner.mode == "respond" and planner.template.endswith("prompts/annotate.md")

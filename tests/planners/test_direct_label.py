@@ -8,7 +8,7 @@ import pytest
 from fake_answers import http_error, ok
 
 from emopose.planners.base import PlanRequest
-from emopose.planners.direct_label import label_from_answer
+from emopose.planners.chat.direct_label import label_from_answer
 from emopose.stages.parse import parse_output, parse_plan
 
 LINE = PlanRequest("It's alright, these things happen to everyone.",

@@ -19,8 +19,8 @@ from fake_answers import (
     truncated,
 )
 
+from emopose.llm.client import LLMConfigError
 from emopose.planners.base import PlanRequest, plan_all
-from emopose.planners.llm_client import LLMConfigError
 from emopose.stages.parse import parse_plan
 
 WELCOME = PlanRequest("Welcome! The screen is over there.")

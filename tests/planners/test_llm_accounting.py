@@ -27,7 +27,7 @@ from fake_openai import FakeOpenAI
 from emopose.app import run
 from emopose.planners.base import PlannerFailure, PlanRequest
 from emopose.stages.parse import Parse, parse_output
-from emopose.turn import Turn
+from emopose.turn.model import Turn
 from tests.conftest import synthetic_library
 
 WELCOME = PlanRequest("Welcome! The screen is over there.")

@@ -9,8 +9,8 @@ from fake_openai import FakeOpenAI
 
 from emopose.build import ConfigError, check_planner
 from emopose.jobs.suite_planning import plan_suite
+from emopose.llm.errors import LLMConfigError
 from emopose.planners.base import PlannerFailure, PlanRequest
-from emopose.planners.llm_errors import LLMConfigError
 
 LINE = PlanRequest("Welcome! The screen is over there.")
 

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from emopose.planners.base import PlanRequest
-from emopose.planners.local import intensity_from_cues, trigger_span
-from emopose.planners.local_data import multi_act, single_act, synthetic_sequences
-from emopose.planners.local_heads import Analysis
-from emopose.planners.segment import segments
+from emopose.planners.local.data import multi_act, single_act, synthetic_sequences
+from emopose.planners.local.heads import Analysis
+from emopose.planners.local.planner import intensity_from_cues, trigger_span
+from emopose.planners.local.segment import segments
 from emopose.stages.parse import parse_plan
 from tests.planners.local_helpers import configured_local_planner
 
@@ -126,7 +126,7 @@ def planner(tmp_path_factory):
 @pytest.mark.slow
 def test_quality_floor_on_held_out_training_slice(planner):
     from emopose.jobs.train_local import context_metrics, held_out_metrics, scored_dialogues
-    from emopose.planners.local_data import load_examples
+    from emopose.planners.local.data import load_examples
 
     held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
     utterances = [e for e in held_out if not e.history]

@@ -31,7 +31,7 @@ def unrelated_histories(planner):
     """Held-out items without history, each with the history of a held-out dialogue (seeded draw)."""
     import random
 
-    from emopose.planners.local_data import load_examples
+    from emopose.planners.local.data import load_examples
 
     held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
     histories = [e.history for e in held_out if e.history]

@@ -56,7 +56,7 @@ def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
 @pytest.mark.slow
 def test_new_motions_cost_the_reading_of_other_utterances_little(tmp_path):
     from emopose.jobs.train_local import held_out_metrics
-    from emopose.planners.local_data import load_examples
+    from emopose.planners.local.data import load_examples
 
     planner = configured_local_planner(tmp_path / "g1")
     examples = [e for e in load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)

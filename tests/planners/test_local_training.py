@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from emopose.planners.local_data import load_examples
-from emopose.planners.local_model import CONTEXT_CHARS, ActModel, context_prefix
+from emopose.planners.local.data import load_examples
+from emopose.planners.local.model import CONTEXT_CHARS, ActModel, context_prefix
 from tests.planners.local_helpers import training_config
 
 DIALOGUE = ({"role": "user", "content": "Can my son touch the starfish?"},
@@ -63,7 +63,7 @@ def test_dialogue_items_and_distractors_are_training_examples(tmp_path):
 
 
 def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, capsys, monkeypatch):
-    from emopose.planners.local_training import fit
+    from emopose.planners.local.training import fit
 
     rows = [("Welcome in, everyone!", "welcoming"), ("The exit is over there.", "pointing"),
             ("No, don't touch that.", "rejecting"), ("Yes, exactly right.", "agreeing"),
@@ -89,7 +89,7 @@ def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, 
 
 def test_the_model_keeps_which_motions_its_training_data_annotates(model, tmp_path):
     # the variant choice weighs a motion's fit more when the class head never read an act about it
-    from emopose.planners.local_training import fit
+    from emopose.planners.local.training import fit
 
     path = write_jsonl(tmp_path / "train.jsonl", [
         {"id": "a", "text": "Hi there! The exit is on your left.", "labels": ["welcoming", "pointing"],
@@ -103,7 +103,7 @@ def test_the_model_keeps_which_motions_its_training_data_annotates(model, tmp_pa
 
 
 def test_linear_schedule_warms_up_then_decays_to_zero():
-    from emopose.planners.local_training import learning_rate_factor
+    from emopose.planners.local.training import learning_rate_factor
 
     factor = learning_rate_factor(training_config(lr_schedule="linear"), 100)
     rates = [factor(step) for step in range(100)]

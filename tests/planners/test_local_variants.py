@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from emopose import CLASSES
-from emopose.planners.local_variants import (
+from emopose.planners.local.variants import (
     AnnotatedAct,
     ClassMove,
     Features,

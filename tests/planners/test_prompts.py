@@ -9,10 +9,10 @@ import pytest
 from emopose import CLASSES
 from emopose.build import ConfigError, make
 from emopose.config import PROJECT_ROOT
-from emopose.planners.direct_label import DirectLabelPlanner
-from emopose.planners.guide import library_guide
-from emopose.planners.llm import LLMPlanner
-from emopose.planners.prompting import PromptError, PromptTemplate
+from emopose.planners.chat.direct_label import DirectLabelPlanner
+from emopose.planners.chat.guide import library_guide
+from emopose.planners.chat.llm import LLMPlanner
+from emopose.planners.chat.prompting import PromptError, PromptTemplate
 
 
 def _section(path, title: str) -> str:
@@ -57,7 +57,7 @@ def test_planner_configs_compose_and_build(writable_library, demonstrations_file
 
 
 def test_demonstration_lines_follow_the_mode(demonstrations_file):
-    from emopose.planners.prompting import load_demonstrations, plan_demonstrations
+    from emopose.planners.chat.prompting import load_demonstrations, plan_demonstrations
 
     demos = load_demonstrations(demonstrations_file)
     demos = [d.__class__(d.id, d.text, "Robot line " + d.id, d.gestures) for d in demos]

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import torch
 
-from emopose.planners.local_data import multi_act, single_act
-from emopose.planners.semi_crf import best_split, log_partition, split_score
+from emopose.planners.local.data import multi_act, single_act
+from emopose.planners.local.semi_crf import best_split, log_partition, split_score
 
 
 def every_split(n: int, spans: list[tuple[int, int]], classes: int):

@@ -11,10 +11,10 @@ from fake_answers import http_error
 from fake_stream import streamed, tokens
 
 from emopose.config import PROJECT_ROOT
-from emopose.planners.annotate import AnnotatePlanner
-from emopose.planners.keyword import KeywordPlanner
+from emopose.execution.sequencer import State
+from emopose.planners.baselines.keyword import KeywordPlanner
+from emopose.planners.chat.annotate import AnnotatePlanner
 from emopose.recording import read_recording
-from emopose.sequencer import State
 from tests.wiring import wire
 
 REPLY = ("Welcome to the lab! The charging dock is over there, by the window. "

@@ -9,7 +9,7 @@ import pytest
 from emopose.app import run
 from emopose.build import build_run, make
 from emopose.config import project_path
-from emopose.sync_record import read_stroke_sync
+from emopose.sync.recording import read_stroke_sync
 from tests.conftest import synthetic_library
 
 FIXTURE_SUITE = project_path("experiments/speech/sync_fixture.jsonl")

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from emopose.backends.dry_run import DryRunBackend
-from emopose.gesture_command import GestureCommand
+from emopose.execution.gesture_command import GestureCommand
 from emopose.planners.base import PlannerOutput
-from emopose.thinking import ThinkingGesture
+from emopose.turn.thinking import ThinkingGesture
 from tests.wiring import wire
 
 REPLY = "Welcome to the lab! The robot arm is over there."

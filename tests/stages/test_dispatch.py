@@ -2,7 +2,7 @@
 
 import pytest
 
-from emopose.sequencer import State
+from emopose.execution.sequencer import State
 from emopose.stages.dispatch import Dispatch
 from tests.stages.test_sequence import scheduled_turn
 from tests.wiring import wire

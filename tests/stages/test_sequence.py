@@ -3,11 +3,11 @@
 import numpy as np
 
 from emopose.contract import GestureRecord, Plan
+from emopose.execution.sequencer import State
 from emopose.planners.base import PlanRequest
-from emopose.sequencer import State
 from emopose.speech.clip import SpeechClip
 from emopose.stages.sequence import SequenceStage
-from emopose.turn import Turn
+from emopose.turn.model import Turn
 from tests.wiring import wire
 
 

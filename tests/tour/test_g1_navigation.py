@@ -14,8 +14,8 @@ import time
 
 import pytest
 
+from emopose.scene.geometry import Pose2D
 from emopose.tour.g1_base import G1Base
-from emopose.tour.geometry import Pose2D
 from emopose.tour.navigator import NavigationSettings, Navigator
 from tests.backends.g1.conftest import FakeRobot, require_dds
 

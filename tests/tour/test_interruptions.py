@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from emopose.sequencer import Sequencer
+from emopose.execution.sequencer import Sequencer
 from emopose.tour.interruptions import Interruptions, asks_about_scene, wants_abort
-from emopose.tour.scenario import parse_tour
+from emopose.tour.scenario_loading import parse_tour
 from tests.tour.tour_helpers import small, tour_runner
 
 AT_NEUTRAL_RAD = 0.03  # the G1's plain law (kp 60, tau = 0) leaves the resting arms ~0.025 rad below neutral

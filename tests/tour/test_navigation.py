@@ -12,11 +12,11 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 from emopose.backends.mujoco import MujocoBackend
 from emopose.backends.planar_base import MujocoPlanarBase
+from emopose.scene.geometry import Pose2D, wrap_angle
 from emopose.tour.controller import GoToPose
 from emopose.tour.g1_base import G1Base
-from emopose.tour.geometry import Pose2D, wrap_angle
 from emopose.tour.navigator import NavigationSettings, Navigator
-from emopose.tour.scenario import load_tour
+from emopose.tour.scenario_loading import load_tour
 from emopose.tour.sim_base import MujocoBase
 from tests.tour.tour_helpers import LAB_FILE
 

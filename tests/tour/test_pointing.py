@@ -12,13 +12,13 @@ from emopose.app import run
 from emopose.contract import GestureRecord, Plan
 from emopose.planners.base import PlanRequest
 from emopose.robot.kinematics import mirror
+from emopose.robot.pointing_ik import aim_arm, pointing_error
+from emopose.scene.geometry import Pose2D
+from emopose.scene.view import SceneSlot, SceneView
+from emopose.stages.aim import AimStage, active_side, peak_indices
 from emopose.stages.resolve import resolve_record
-from emopose.tour.aim import AimStage, active_side, peak_indices
-from emopose.tour.geometry import Pose2D
-from emopose.tour.pointing_ik import aim_arm, pointing_error
-from emopose.tour.scenario import parse_tour
-from emopose.tour.scene_view import SceneSlot, SceneView
-from emopose.turn import ModulatedGesture, Turn
+from emopose.tour.scenario_loading import parse_tour
+from emopose.turn.model import ModulatedGesture, Turn
 from tests.tour.tour_helpers import compose_config, small, synthetic_library
 
 POINT_RIGHT = np.array([0.1, 0.12, 0, 1.2, 0, 0, 0, -1.4, -0.8, 0, 1.25, 0, 0.1, 0])

@@ -8,7 +8,8 @@ import pytest
 import yaml
 
 from emopose.tour.job import TourJob
-from emopose.tour.scenario import TourConfigError, load_tour, parse_tour
+from emopose.tour.scenario import TourConfigError
+from emopose.tour.scenario_loading import load_tour, parse_tour
 from tests.tour.tour_helpers import LAB_FILE, lab_raw, small
 
 

@@ -15,7 +15,7 @@ from emopose.build import build_run
 from emopose.config import CONFIG_DIR
 from emopose.tour.camera import camera_for
 from emopose.tour.runner import TourRunner
-from emopose.tour.scenario import parse_tour
+from emopose.tour.scenario_loading import parse_tour
 from emopose.tour.sim_base import MujocoBase
 from emopose.tour.sim_scene import install_scene
 from tests.jobs.sim_helpers import RENDER_SKIP, compose_config, synthetic_library  # noqa: F401

@@ -10,8 +10,8 @@ import time
 import pytest
 
 from emopose.config import PROJECT_ROOT
-from emopose.planners.annotate import AnnotatePlanner
-from emopose.planners.keyword import KeywordPlanner
+from emopose.planners.baselines.keyword import KeywordPlanner
+from emopose.planners.chat.annotate import AnnotatePlanner
 
 sys.path.insert(0, str(PROJECT_ROOT / "tests" / "planners"))  # the fake servers are helpers, not tests
 from fake_openai import FakeOpenAI  # noqa: E402

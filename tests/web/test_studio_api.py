@@ -91,7 +91,7 @@ def test_save_round_trip_with_backup_and_overwrite(client, library_copy):
 
 
 def test_a_saved_variant_resolves_and_runs_on_the_next_request(client):
-    from emopose.planners.guide import library_guide
+    from emopose.planners.chat.guide import library_guide
 
     version = client.get("/api/library").json()["version"]
     assert client.post("/api/resolve", json={"class": "welcoming", "variant": "wave_test_variant"}).json()["rule"] \

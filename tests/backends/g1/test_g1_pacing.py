@@ -11,12 +11,12 @@ import pytest
 
 from emopose.backends.g1 import G1Backend
 from emopose.clock import MonotonicClock
-from emopose.control_loop import ControlLoop
+from emopose.execution.control_loop import ControlLoop
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.recording import read_recording
 from emopose.robot.g1_spec import CONTROL_DT
-from emopose.sequencer import Sequencer
-from emopose.session import Session
-from emopose.trajectory import TrajectoryBuilder
+from emopose.turn.session import Session
 
 pytestmark = pytest.mark.slow  # a real-time session: ramp, 1 s of thinking, 0.5 s of stream, release
 

@@ -1,0 +1,169 @@
+"""The 50 Hz loop: ticks the sequencer on absolute deadlines and hands each target to the backend.
+
+Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt) chains). Deadlines
+that passed a whole period ago, or before the previous command went out, are skipped, not sent in a
+burst: after a stall (or while nobody drove the loop, e.g. the planner was thinking) the loop
+re-anchors on its grid and counts what it skipped; and no command follows the previous one by less
+than half a period. The sequencer plays its samples tick by tick, so a skip delays a motion, never jumps it.
+With a FakeClock the same loop renders a run as fast as the CPU allows; with MonotonicClock it is
+real time. `run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background
+thread for the web UI, speech and the tour; `wait_until()` waits the right way for either.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from emopose import CONTROL_DT
+from emopose.backends.base import Backend
+from emopose.clock import Clock
+from emopose.execution.sequencer import Sequencer
+from emopose.recording import Recorder
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class LoopStats:
+    """Counters over the whole run, and the lateness of the last `window` ticks (a long serve must not
+    grow a list forever): percentiles are over that window, the maximum over the whole run."""
+
+    window: int = 3000  # one minute at 50 Hz
+    ticks: int = 0
+    missed_deadlines: int = 0  # deadlines skipped because the loop fell behind while it was driven
+    stalls: int = 0  # how often it fell behind by a whole period and re-anchored
+    idle_ticks: int = 0  # deadlines skipped while nobody drove the loop (between run_until calls)
+    lateness_max_s: float = 0.0
+    lateness_s: deque[float] = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.lateness_s = deque(maxlen=self.window)
+
+    def add(self, lateness: float) -> None:
+        self.ticks += 1
+        self.lateness_s.append(lateness)
+        self.lateness_max_s = max(self.lateness_max_s, lateness)
+
+    def summary(self) -> dict:
+        late = np.asarray(self.lateness_s or [0.0]) * 1e3
+        return {"ticks": self.ticks, "missed_deadlines": self.missed_deadlines, "stalls": self.stalls,
+                "idle_ticks": self.idle_ticks, "lateness_ms_p50": float(np.percentile(late, 50)),
+                "lateness_ms_p99": float(np.percentile(late, 99)), "lateness_ms_max": self.lateness_max_s * 1e3}
+
+
+class ControlLoop:
+    def __init__(self, sequencer: Sequencer, backend: Backend, clock: Clock, dt: float = CONTROL_DT) -> None:
+        self.sequencer, self.backend, self.clock, self.dt = sequencer, backend, clock, dt
+        self.recorder: Recorder | None = None
+        self.stats = LoopStats()
+        self._t0: float | None = None
+        self._tick = 0
+        self._last_sent = -np.inf  # clock time the previous command went out
+        self._resuming = True  # nobody drove the loop since the last tick: lag is idle time, not a stall
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+        self.error: BaseException | None = None
+
+    def begin(self, q0: np.ndarray, recorder: Recorder | None = None) -> None:
+        """Start the stream at the measured pose q0, recording every command to `recorder`."""
+        self.recorder = recorder
+        self._t0 = self.clock.now()
+        self._tick = 0
+        self._resuming = True
+        self.sequencer.reset(q0, self._t0)
+        if recorder is not None:
+            if recorder.clock is not self.clock:
+                raise ValueError("control loop: the recorder must run on the loop's clock (one time base)")
+            recorder.start_stream(self._t0)
+
+    @property
+    def stream_time(self) -> float:
+        return self.clock.now() - (self._t0 or 0.0)
+
+    def stream_time_of(self, clock_time: float) -> float:
+        """A time read from the loop's clock, on the stream's time base (the `t` of /joints/command)."""
+        return clock_time - (self._t0 or 0.0)
+
+    def tick(self) -> np.ndarray:
+        deadline = self._t0 + (self._tick + 1) * self.dt
+        # Deadlines a whole period past, or at or before the previous send (it stood for them), are
+        # skipped: the loop re-anchors on the grid instead of bursting the backlog out.
+        covered = max(self.clock.now() - self.dt, self._last_sent)
+        behind = math.floor((covered - deadline) / self.dt + 1e-9) + 1 if covered >= deadline - 1e-12 else 0
+        if behind > 0:
+            self._tick += behind
+            deadline = self._t0 + (self._tick + 1) * self.dt
+            if self._resuming:
+                self.stats.idle_ticks += behind
+            else:
+                self.stats.missed_deadlines += behind
+                self.stats.stalls += 1
+        self._resuming = False
+        self.clock.sleep_until(max(deadline, self._last_sent + self.dt / 2))
+        self.stats.add(self.clock.now() - deadline)
+        self._tick += 1
+        q = self.sequencer.step(deadline)
+        t = deadline - self._t0
+        self.backend.send(t, q)
+        self._last_sent = self.clock.now()
+        if self.recorder is not None:
+            self.recorder.write("/joints/command", t, {"t": t, "q": q.tolist()})
+        return q
+
+    def run_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
+        """Tick until done() (checked after each tick) or timeout (stream seconds). True if done.
+        Time since the previous drive (a planner call, say) is idle, skipped at the first tick."""
+        self._resuming = True
+        end = self.stream_time + timeout_s
+        while self.stream_time < end:
+            self.tick()
+            if done():
+                return True
+        return False
+
+    def wait_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
+        """done() within timeout_s: polled (wall time) while the loop runs on its thread, else ticked here."""
+        if not self.running:
+            return self.run_until(done, timeout_s)
+        end = time.monotonic() + timeout_s
+        while time.monotonic() < end:
+            if done():
+                return True
+            if self.error is not None:
+                raise RuntimeError("control loop failed") from self.error
+            time.sleep(0.01)
+        return False
+
+    # -- background thread ---------------------------------------------------------------------
+    def start(self) -> None:
+        if self._thread is not None:
+            return
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._run, name="emopose-control", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        try:
+            while not self._stop.is_set():
+                self.tick()
+        except BaseException as exc:  # surfaced to the owner; the backend's close() does the safe release
+            self.error = exc
+            log.exception("control loop stopped")
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=2.0)
+            self._thread = None
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive()

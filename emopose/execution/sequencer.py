@@ -1,0 +1,263 @@
+"""The robot-side gesture sequencer (paper Fig. sequencer): one active trajectory, a FIFO queue.
+
+IDLE/HOLDING --released command--> EXECUTING (trajectory built from the latest published pose)
+EXECUTING --done, successor released--> BLENDING (cubic, <= blend_s) --> EXECUTING
+EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> BLENDING to neutral
+                                                (recover_s) --> IDLE
+any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
+Beyond the paper (off by default): with `preempt_after_s` set, a queued command whose release time has
+passed by that much cuts the running motion short with a normal blend, so long motions do not push
+later gestures away from their words; a negative value (-blend_s) starts that blend early so the
+successor begins on its word.
+
+`step(now)` is called once per 50 Hz tick and returns the 14-DoF target to publish; every transition
+starts from the latest published pose, so the stream never jumps. submit/interrupt are thread-safe.
+Time is whatever `now` the caller passes: tests drive it with a fake clock.
+
+Timed commands (the stroke-synchronous timeline, emopose/turn/timeline.py) carry every keyframe's time: one
+starts at its release time from the pose published then (no blend in front: its first segment is its
+own transition), preempting ("cut") a motion still running, and its trajectory meets the keyframe
+times, lengthening only what the speed bound forbids. Events: started, stroke (the arm within
+STROKE_TOLERANCE of the stroke-start keyframe), completed, cut (ended after its stroke, co-articulated or preempted), stopped,
+rejected, dropped (by the timeline, with its reason), state.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import replace
+from enum import StrEnum
+
+import numpy as np
+
+from emopose.execution.bounded_log import BoundedLog
+from emopose.execution.gesture_command import Event, GestureCommand
+from emopose.execution.trajectory import Trajectory, TrajectoryBuilder
+from emopose.sync.strokes import first_within
+
+
+class State(StrEnum):
+    IDLE = "idle"
+    EXECUTING = "executing"
+    HOLDING = "holding"
+    BLENDING = "blending"
+
+
+SafetyCheck = Callable[[np.ndarray], "str | None"]
+
+
+class Sequencer:
+    def __init__(
+        self,
+        builder: TrajectoryBuilder,
+        neutral: np.ndarray,
+        safety: SafetyCheck | None = None,
+        blend_s: float = 0.3,
+        hold_s: float = 2.0,
+        recover_s: float = 1.0,
+        interrupt_blend_s: float = 0.3,
+        neutral_tolerance: float = 0.02,
+        preempt_after_s: float | None = None,
+        on_event: Callable[[Event], None] | None = None,
+        keep_events: int = 10_000,
+    ) -> None:
+        self.builder = builder
+        self.neutral = np.asarray(neutral, dtype=float)
+        self.safety = safety
+        self.blend_s, self.hold_s, self.recover_s = blend_s, hold_s, recover_s
+        self.interrupt_blend_s = interrupt_blend_s
+        self.neutral_tolerance = neutral_tolerance
+        self.preempt_after_s = preempt_after_s
+        self.on_event = on_event
+        self.events: BoundedLog[Event] = BoundedLog(keep_events)
+        self.construction_s: BoundedLog[float] = BoundedLog(keep_events)
+        self._lock = threading.RLock()
+        self._queue: deque[GestureCommand] = deque()
+        self.reset(self.neutral, 0.0)
+
+    # -- public, thread-safe -------------------------------------------------------------------
+    def reset(self, q0: np.ndarray, now: float) -> None:
+        with self._lock:
+            self.last = np.array(q0, dtype=float)
+            self.state = State.IDLE
+            self._queue.clear()
+            self._motion: Trajectory | None = None
+            self._index = 0
+            self._active: GestureCommand | None = None
+            self._after_blend: GestureCommand | None = None
+            self._stroke_tick = -1
+            self._hold_since = now
+
+    def submit(self, command: GestureCommand) -> None:
+        with self._lock:
+            self._queue.append(command)
+
+    def drop(self, command: GestureCommand, reason: str, now: float) -> None:
+        """Record a gesture the timeline could not fit (it is never queued)."""
+        with self._lock:
+            self._emit(now, "dropped", command, reason)
+
+    def interrupt(self, commands: list[GestureCommand] | tuple = (), now: float | None = None) -> None:
+        """Clear pending actions; blend from the latest published pose to the first new command (or neutral).
+        A timeline (timed commands) is queued whole: the arm heads for rest until its first gesture's
+        start, which then prepares from wherever the arm is."""
+        with self._lock:
+            now = self._hold_since if now is None else now
+            if self._active is not None:
+                self._emit(now, "stopped", self._active)
+            self._queue.clear()
+            timed = bool(commands) and commands[0].timed
+            self._queue.extend(commands if timed else commands[1:])
+            if commands and not timed:
+                first = commands[0]
+                self._start_blend(now, np.asarray(first.keyframes[0]), self.interrupt_blend_s, first)
+            else:
+                self._start_blend(now, self.neutral, self.recover_s, None)
+
+    def retime(self, ids: set[int], delta: float) -> int:
+        """Move the release of the queued commands in `ids` by delta seconds (their speech started that much
+        later than planned); returns how many moved. Commands already running are not touched."""
+        with self._lock:
+            moved = 0
+            for k, command in enumerate(self._queue):
+                if command.id in ids:
+                    self._queue[k] = replace(command, release_at=command.release_at + delta)
+                    moved += 1
+            return moved
+
+    @property
+    def pending(self) -> list[GestureCommand]:
+        with self._lock:
+            return list(self._queue)
+
+    @property
+    def active(self) -> GestureCommand | None:
+        return self._active
+
+    def settled(self) -> bool:
+        """Nothing running and nothing queued (HOLDING or IDLE)."""
+        with self._lock:
+            return self.state in (State.IDLE, State.HOLDING) and not self._queue
+
+    # -- the tick ------------------------------------------------------------------------------
+    def step(self, now: float) -> np.ndarray:
+        with self._lock:
+            if self.state in (State.EXECUTING, State.BLENDING):
+                self._advance(now)
+            if self.state == State.EXECUTING and self._timed_head_due(now):
+                self._emit(now, "cut", self._active, "preempted at the next gesture's timeline start")
+                self._active = None
+                self._begin_or_hold(self._queue.popleft(), now)
+            if self.state == State.EXECUTING and self._overdue(now):
+                self._emit(now, "stopped", self._active, "preempted by an overdue successor")
+                head = self._queue.popleft()
+                self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
+            if self.state in (State.IDLE, State.HOLDING) or self._recovering():
+                self._maybe_start(now)
+            if self.state == State.HOLDING and now - self._hold_since >= self.hold_s:
+                self._recover(now)
+            return self.last.copy()
+
+    # -- internals (lock held) -----------------------------------------------------------------
+    def _advance(self, now: float) -> None:
+        self._index += 1
+        self.last = self._motion.samples[self._index].copy()
+        if self._index == self._stroke_tick and self.state == State.EXECUTING:
+            self._emit(now, "stroke", self._active)
+        if self._index < len(self._motion.samples) - 1:
+            return
+        if self.state == State.EXECUTING:
+            done = self._active
+            self._emit(now, *(("cut", done, "co-articulated into the next gesture") if done.cut else ("completed", done)))
+            self._active = None
+            head = self._queue[0] if self._queue else None
+            if head is not None and head.release_at <= now:
+                self._queue.popleft()
+                if head.timed:
+                    self._begin_or_hold(head, now)
+                else:
+                    self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
+            else:
+                self._set_state(now, State.HOLDING)
+        elif self._after_blend is not None:
+            command, self._after_blend = self._after_blend, None
+            self._begin_or_hold(command, now)
+        else:
+            self._set_state(now, State.IDLE)
+
+    def _timed_head_due(self, now: float) -> bool:
+        return bool(self._queue) and self._queue[0].timed and self._queue[0].release_at <= now
+
+    def _overdue(self, now: float) -> bool:
+        return (self.preempt_after_s is not None and bool(self._queue)
+                and now - self._queue[0].release_at >= self.preempt_after_s)
+
+    def _recovering(self) -> bool:
+        return self.state == State.BLENDING and self._after_blend is None and self._active is None
+
+    def _maybe_start(self, now: float) -> None:
+        while self._queue and self._queue[0].release_at <= now:
+            if self._begin(self._queue.popleft(), now):
+                return
+
+    def _begin(self, command: GestureCommand, now: float) -> bool:
+        started = time.perf_counter()
+        if command.timed:
+            times = np.asarray(command.offsets[1:]) + (command.release_at - now)
+            motion = self.builder.build_timed(command.keyframes, times, self.last, command.blend_in)
+        else:
+            motion = self.builder.build(command.keyframes, command.duration, self.last)
+        self.construction_s.append(time.perf_counter() - started)
+        reason = self.safety(motion.samples) if self.safety else None
+        if reason is not None:
+            self._emit(now, "rejected", command, reason)
+            return False
+        self._motion, self._index, self._active = motion, 0, command
+        self._stroke_tick = self._arrival_tick(motion, command)
+        self._set_state(now, State.EXECUTING)
+        detail = (f"late={motion.late_s * 1e3:.0f}ms" if motion.late_s > 0.01
+                  else f"stretch={motion.stretch:.2f}" if motion.stretch > 1 else "")
+        self._emit(now, "started", command, detail)
+        return True
+
+    @staticmethod
+    def _arrival_tick(motion: Trajectory, command: GestureCommand) -> int:
+        """The sample at which the stroke arrives (within STROKE_TOLERANCE of its start keyframe, on
+        the way there), or -1 without a declared stroke."""
+        if command.stroke is None:
+            return -1
+        start = command.stroke[0]
+        reached = motion.anchor_ticks[max(start, 1)]
+        hit = first_within(motion.samples[1:reached + 1], np.asarray(command.keyframes)[start])
+        return reached if hit is None else 1 + hit
+
+    def _begin_or_hold(self, command: GestureCommand, now: float) -> None:
+        if not self._begin(command, now):
+            self._set_state(now, State.HOLDING)
+
+    def _start_blend(self, now: float, target: np.ndarray, duration: float, then: GestureCommand | None) -> None:
+        self._motion = self.builder.blend(self.last, target, duration)
+        self._index, self._active, self._after_blend = 0, None, then
+        self._set_state(now, State.BLENDING)
+
+    def _recover(self, now: float) -> None:
+        if np.max(np.abs(self.last - self.neutral)) <= self.neutral_tolerance:
+            self._set_state(now, State.IDLE)
+        else:
+            self._start_blend(now, self.neutral, self.recover_s, None)
+
+    def _set_state(self, now: float, state: State) -> None:
+        if state == State.HOLDING:
+            self._hold_since = now
+        if state != self.state:
+            self.state = state
+            self._emit(now, "state", None, state.value)
+
+    def _emit(self, now: float, kind: str, command: GestureCommand | None, detail: str = "") -> None:
+        event = Event(now, kind, command.name if command else "", command.id if command else None, detail)
+        self.events.append(event)
+        if self.on_event is not None:
+            self.on_event(event)

@@ -1,0 +1,190 @@
+"""One chat-completion client for every LLM planner: litellm, our own retry loop, a response cache.
+
+The retry loop is ours (litellm's and the OpenAI SDK's own retries are switched off) so the number
+of attempts is visible to counters and tests, and so only transient failures are retried
+(emopose/llm/errors.py sorts them). litellm is imported on first use: it takes seconds to
+import and most runs never call it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import threading
+import time
+from dataclasses import dataclass
+
+from emopose.llm.cache import ResponseCache, cache_key
+from emopose.llm.counters import CallCounters
+from emopose.llm.errors import LLMCallError, LLMConfigError, backoff_delay, cause, is_transient
+from emopose.llm.errors import litellm_module as _litellm
+
+NO_KEY_PLACEHOLDER = "no-key-needed"  # the OpenAI SDK refuses a missing key even for a local server
+
+
+def effective_api_key(litellm, model: str, api_base: str | None, api_key: str | None) -> str | None:
+    """For every litellm call: the configured key; else None (litellm reads the provider's env var); a keyless
+    local server (api_base set, no key anywhere) gets a placeholder: the OpenAI SDK refuses to send without one."""
+    if api_key or not api_base:
+        return api_key
+    return None if litellm.validate_environment(model=model).get("keys_in_environment") else NO_KEY_PLACEHOLDER
+
+
+@dataclass(frozen=True)
+class Completion:
+    text: str
+    attempts: int
+    cached: bool
+    finish_reason: str | None = None
+    latency_s: float = 0.0  # model time incl. retries and backoff; 0 for a cache hit
+    queued_s: float = 0.0  # time spent waiting for a concurrency slot (plan_many), apart from latency_s
+
+
+class LLMClient:
+    """Chat completion with any litellm model string (openai/..., anthropic/..., ollama/..., hosted_vllm/...)."""
+
+    def __init__(self, model: str = "openai/gpt-4o-mini", api_base: str | None = None, api_key: str | None = None,
+                 temperature: float = 0.7, max_tokens: int | None = 1024, timeout_s: float = 60.0,
+                 max_retries: int = 3, backoff_s: float = 1.0, backoff_max_s: float = 30.0, cache: bool = True,
+                 cache_dir: str = "~/.cache/emopose/llm", extra_params: dict | None = None) -> None:
+        if not isinstance(model, str) or not model.strip():
+            raise LLMConfigError("planner.model is empty; give a litellm model string such as openai/gpt-4o-mini")
+        for key, value, low in (("temperature", temperature, 0), ("timeout_s", timeout_s, 1e-3),
+                                ("max_retries", max_retries, 0), ("backoff_s", backoff_s, 0)):
+            if value < low:
+                raise LLMConfigError(f"planner.{key} = {value} must be >= {low}")
+        self.model, self.api_base, self.api_key = model, api_base or None, api_key or None
+        self.temperature, self.max_tokens, self.timeout_s = float(temperature), max_tokens, float(timeout_s)
+        self.max_retries, self.backoff_s, self.backoff_max_s = int(max_retries), float(backoff_s), float(backoff_max_s)
+        self.extra_params = dict(extra_params or {})
+        self.cache = ResponseCache(cache_dir) if cache else None
+        self.counters = CallCounters()
+        self._key_resolved: tuple[str | None] | None = None  # decided on the first call (needs litellm)
+        self._repeats: dict[str, int] = {}
+        self._repeats_lock = threading.Lock()
+
+    @property
+    def sampled(self) -> bool:
+        """True when repeated passes are independent draws (temperature > 0; the pass index keys the cache)."""
+        return self.temperature > 0
+
+    # -- one request -------------------------------------------------------------------------
+    def _key(self, messages: list[dict], pass_index: int, response_format: dict | None) -> str:
+        return cache_key({"model": self.model, "api_base": self.api_base, "messages": messages,
+                          "temperature": self.temperature, "max_tokens": self.max_tokens,
+                          "extra": self.extra_params, "pass": pass_index if self.sampled else None,
+                          **({"response_format": response_format} if response_format else {})})
+
+    def call_kwargs(self, messages: list[dict], response_format: dict | None = None, **overrides) -> dict:
+        """litellm.completion's arguments for one request (`overrides`: e.g. the probe's max_tokens=1)."""
+        api_key = self._effective_key()
+        kwargs = {"model": self.model, "messages": messages, "temperature": self.temperature,
+                  "timeout": self.timeout_s, "max_retries": 0, "num_retries": 0, **self.extra_params}
+        if self.max_tokens:
+            kwargs["max_tokens"] = self.max_tokens
+        if response_format:
+            kwargs["response_format"] = response_format
+        if self.api_base:
+            kwargs["api_base"] = self.api_base
+        if api_key:
+            kwargs["api_key"] = api_key
+        return {**kwargs, **overrides}
+
+    def _effective_key(self) -> str | None:
+        if self._key_resolved is None:  # asked once: validate_environment reads the environment
+            self._key_resolved = (effective_api_key(_litellm(), self.model, self.api_base, self.api_key),)
+        return self._key_resolved[0]
+
+    def _draw_key(self, messages: list[dict], pass_index: int, response_format: dict | None) -> str:
+        """The cache key of this call. While sampling, the n-th identical request (n > 0) within this
+        client's life is its own draw: five passes whose job never set pass_index still get five
+        samples, and a rerun in a new process replays them in the same order."""
+        key = self._key(messages, pass_index, response_format)
+        if not self.sampled:
+            return key
+        with self._repeats_lock:
+            repeat = self._repeats.get(key, 0)
+            self._repeats[key] = repeat + 1
+        return cache_key({"draw": key, "repeat": repeat}) if repeat else key
+
+    def _lookup(self, messages: list[dict], pass_index: int,
+                response_format: dict | None) -> tuple[str | None, Completion | None]:
+        self.counters.add(calls=1)
+        if self.cache is None:
+            return None, None
+        key = self._draw_key(messages, pass_index, response_format)
+        text = self.cache.get(key)
+        if text is None:
+            return key, None
+        self.counters.add(cache_hits=1)
+        return key, Completion(text, attempts=0, cached=True)
+
+    def _retry_delay(self, exc: Exception, attempt: int, started: float, queued_s: float = 0.0) -> float:
+        """Backoff before the next attempt, or raise LLMCallError when the failure is final."""
+        if attempt >= self.max_retries or not is_transient(exc):
+            latency = time.perf_counter() - started
+            self.counters.latency(latency, queued_s)
+            raise LLMCallError(f"{type(exc).__name__} after {attempt + 1} attempt(s): {str(exc)[:300]}",
+                               latency, cause(exc, self.model, self.api_base)) from exc
+        self.counters.add(retries=1)
+        return backoff_delay(attempt, self.backoff_s, self.backoff_max_s, exc)
+
+    def _finish(self, key: str | None, response, attempts: int, started: float, queued_s: float = 0.0) -> Completion:
+        latency = time.perf_counter() - started
+        self.counters.latency(latency, queued_s)
+        choice = response.choices[0]
+        text = choice.message.content or ""
+        if self.cache and key and text.strip():  # an empty answer is usually a provider hiccup: ask again next time
+            self.cache.put(key, text, {"model": self.model, "finish_reason": choice.finish_reason})
+        return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason, latency_s=latency,
+                          queued_s=queued_s)
+
+    def complete(self, messages: list[dict], pass_index: int = 0,
+                 response_format: dict | None = None) -> Completion:  # type: ignore[return]
+        """The answer to one chat request: from the cache, or from the model with retries."""
+        key, hit = self._lookup(messages, pass_index, response_format)
+        if hit is not None:
+            return hit
+        kwargs, started = self.call_kwargs(messages, response_format), time.perf_counter()
+        for attempt in itertools.count():
+            try:
+                response = _litellm().completion(**kwargs)
+            except Exception as exc:  # noqa: BLE001 - litellm raises many types; is_transient sorts them
+                time.sleep(self._retry_delay(exc, attempt, started))
+                continue
+            return self._finish(key, response, attempt + 1, started)
+
+    def open_stream(self, messages: list[dict]) -> tuple[object, int]:
+        """litellm's stream of one chat request (stream=True) and the attempts it took: opened with the
+        same retries as complete(), never cached (a streamed answer is spoken as it arrives)."""
+        self.counters.add(calls=1)
+        kwargs, started = self.call_kwargs(messages, stream=True), time.perf_counter()
+        for attempt in itertools.count():
+            try:
+                return _litellm().completion(**kwargs), attempt + 1
+            except Exception as exc:  # noqa: BLE001 - as in complete()
+                time.sleep(self._retry_delay(exc, attempt, started))
+
+    async def acomplete(self, messages: list[dict], pass_index: int = 0, gate: asyncio.Semaphore | None = None,
+                        response_format: dict | None = None) -> Completion:  # type: ignore[return]
+        """As complete(); `gate` bounds requests on the wire (a call in backoff frees its slot). Waiting
+        for a slot is the batch's queueing, not model latency: it is counted apart (queue_s)."""
+        key, hit = self._lookup(messages, pass_index, response_format)
+        if hit is not None:
+            return hit
+        kwargs, slot = self.call_kwargs(messages, response_format), gate or contextlib.nullcontext()
+        started, queued_s = None, 0.0
+        for attempt in itertools.count():
+            queued = time.perf_counter()
+            async with slot:
+                waited = time.perf_counter() - queued
+                queued_s += waited
+                started = time.perf_counter() if started is None else started + waited
+                try:
+                    response = await _litellm().acompletion(**kwargs)
+                except Exception as exc:  # noqa: BLE001 - as in complete()
+                    delay = self._retry_delay(exc, attempt, started, queued_s)
+                else:
+                    return self._finish(key, response, attempt + 1, started, queued_s)
+            await asyncio.sleep(delay)

@@ -1,0 +1,1 @@
+"""The paper's non-LLM baselines: keyword, TF-IDF, Jaccard, SBERT centroids and chance."""

@@ -1,0 +1,107 @@
+"""planner=annotate: any chat model speaks, the robot's own gesture planner annotates (beyond the paper).
+
+respond mode: a chat model (any litellm model string) writes the reply as plain spoken text from the
+dialogue history and the camera image (prompts/annotate.md); the annotator, the robot-side gesture
+planner (planner=local by default), then plans that reply: classes, variants, intensities, and
+triggers that are exact spans of it, so the say-do check holds by construction. Nothing asks the chat
+model for JSON, so small or JSON-weak models become usable.
+narrate mode: the line is given, so no model is asked: the annotator plans the line itself.
+stream=true (respond mode): the reply streams in (litellm stream=True) and is cut into sentences as
+they complete; each is annotated on its own and handed on (SentencePlans) while the model writes on.
+If the stream fails before its first sentence the turn falls back as plan() does; after it, the
+failure is raised (what was said stays said).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any
+
+from emopose.library import MotionLibrary
+from emopose.llm.errors import LLMCallError
+from emopose.llm.stream import TextStream
+from emopose.planners.base import Planner, PlannerOutput, PlanRequest, plan_all
+from emopose.planners.chat.planner import ChatPlanner
+from emopose.planners.chat.prompting import dialogue_demonstrations
+from emopose.planners.streaming import SentencePlans
+from emopose.speech.sentences import SentenceSplitter
+
+MODES = ("respond", "narrate")
+
+
+class AnnotatePlanner(ChatPlanner):
+    """`annotator`: a Planner, or a factory taking the library (a Hydra `_partial_` node). `stream`: speak
+    sentence by sentence; `stream_preroll_s`: the most the first sentence's speech waits for its first
+    gesture to prepare (the timeline's max_preroll_s for that sentence: speech starts sooner)."""
+
+    name = "annotate"
+
+    def __init__(self, library: MotionLibrary, template: str, demonstrations: str,
+                 annotator: Planner | Callable[..., Planner], mode: str = "respond", stream: bool = False,
+                 stream_preroll_s: float = 0.0, **kwargs: Any) -> None:
+        super().__init__(library, template, demonstrations, **kwargs)
+        if mode not in MODES:
+            raise ValueError(f"planner.mode = {mode!r}; choose one of {MODES}")
+        if stream_preroll_s < 0:
+            raise ValueError(f"planner.stream_preroll_s = {stream_preroll_s} must be >= 0")
+        self.mode, self.narrates = mode, mode == "narrate"
+        self.streams, self.stream_preroll_s = bool(stream) and not self.narrates, float(stream_preroll_s)
+        self.template.require("demonstrations", hint="planner=annotate uses prompts/annotate.md.")
+        self._system = self.template.render(demonstrations=dialogue_demonstrations(self.demonstrations))
+        self.annotator = annotator if isinstance(annotator, Planner) else annotator(library=library)
+
+    def system_prompt(self) -> str:
+        return self._system
+
+    def check(self) -> None:
+        if not self.narrates:  # narration never asks the chat model
+            super().check()
+
+    def to_contract(self, text: str, request: PlanRequest) -> str:
+        """The spoken reply, planned by the annotator as a line that answers the person's words."""
+        reply = " ".join(text.split())
+        if not reply:
+            return ""  # parse reports it as an empty answer
+        heard = ({"role": "user", "content": request.utterance},)
+        annotated = json.loads(self.annotator.plan(PlanRequest(reply, history=request.history + heard)).raw)
+        return json.dumps({**annotated, "reply": reply})
+
+    def plan(self, request: PlanRequest) -> PlannerOutput:
+        if self.narrates:
+            return self.annotator.plan(request)
+        return super().plan(request)
+
+    def plan_many(self, requests: Sequence[PlanRequest]) -> list[PlannerOutput]:
+        if self.narrates:
+            return plan_all(self.annotator, requests)
+        return super().plan_many(requests)
+
+    def stream(self, request: PlanRequest) -> SentencePlans:
+        text = TextStream(self.client, self.messages(request))
+        return SentencePlans(self._sentences(text, request), text.cancel)
+
+    def _sentences(self, text: TextStream, request: PlanRequest) -> Iterator[PlannerOutput]:
+        started, splitter, count = time.perf_counter(), SentenceSplitter(), 0
+        try:
+            for piece in text:
+                for sentence in splitter.feed(piece):
+                    yield self._sentence(sentence, count, text, request, started)
+                    count += 1
+            rest = splitter.flush()
+            if rest and not text.cancelled:
+                yield self._sentence(rest, count, text, request, started)
+        except LLMCallError as exc:
+            if count:
+                raise
+            yield self._fallback(request, exc, self.pass_index, time.perf_counter() - started)
+
+    def _sentence(self, sentence: str, index: int, text: TextStream, request: PlanRequest,
+                  started: float) -> PlannerOutput:
+        complete = time.perf_counter()
+        raw = self.to_contract(sentence, request)
+        done = time.perf_counter()
+        meta = {"model": self.client.model, "sentence": index, "attempts": text.attempts,
+                "first_token_s": text.first_token_s, "sentence_s": complete - started, "annotate_s": done - complete}
+        return PlannerOutput(raw=raw, latency_s=done - started, meta=meta)

@@ -1,0 +1,100 @@
+"""planner=llm: the paper's full structured planner (GPT-class chat model through litellm).
+
+The system prompt is a template from prompts/ rendered with the live library guide, the in-context
+demonstrations, the plan-length limit and the mode; the dialogue history follows as prior turns and
+the utterance (with an optional camera image) comes last. The template picks the guide's form by its
+placeholder: ${library_guide} (a line per motion, prompts/structured.md) or ${library_names} (a line
+per class, prompts/compact.md for small local models).
+
+Structured output (planner.structured_output): the answer's JSON schema (emopose.contract.plan_schema,
+the eight classes and the live variant names as enums) goes out as response_format where litellm
+reports the model supports schemas; {"type": "json_object"} where it supports only that; nothing
+(prompt only) otherwise. "auto" asks litellm; json_schema | json_object | none force a choice (a
+llama.cpp or vLLM server takes json_schema though litellm has no card for it). The answer is returned
+untouched as raw contract JSON: validating it is the parse stage's job, the one edge for model output.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from emopose.contract import plan_schema
+from emopose.library import MotionLibrary
+from emopose.llm.errors import litellm_module
+from emopose.planners.chat.guide import library_guide
+from emopose.planners.chat.planner import ChatPlanner
+from emopose.planners.chat.prompting import PromptError, plan_demonstrations
+
+MODES = ("narrate", "respond")
+STRUCTURED = ("auto", "json_schema", "json_object", "none")
+GUIDES = {"library_guide": "full", "library_names": "short"}  # placeholder -> guide form
+
+
+def supported_structured_output(model: str) -> str:
+    """What litellm reports the model accepts: json_schema, json_object, or none."""
+    litellm = litellm_module()
+    try:
+        if litellm.supports_response_schema(model=model):
+            return "json_schema"
+        _, provider, _, _ = litellm.get_llm_provider(model=model)
+        params = litellm.get_supported_openai_params(model=model, custom_llm_provider=provider) or []
+    except Exception:  # noqa: BLE001 - a model litellm cannot describe: ask in the prompt only
+        return "none"
+    return "json_object" if "response_format" in params else "none"
+
+
+class LLMPlanner(ChatPlanner):
+    """mode=narrate: the utterance is the robot's own line (reply = utterance; the benchmarks).
+    mode=respond: the utterance is a person speaking to the robot, which answers (dialogue, tour Q&A)."""
+
+    name = "llm"
+
+    def __init__(self, library: MotionLibrary, template: str, demonstrations: str, mode: str = "narrate",
+                 max_gestures: int = 4, structured_output: str = "auto", **kwargs: Any) -> None:
+        super().__init__(library, template, demonstrations, **kwargs)
+        if mode not in MODES:
+            raise ValueError(f"planner.mode = {mode!r}; choose one of {MODES}")
+        if not 1 <= max_gestures <= 8:
+            raise ValueError(f"planner.max_gestures = {max_gestures} must be in 1..8")
+        if structured_output not in STRUCTURED:
+            raise ValueError(f"planner.structured_output = {structured_output!r}; choose one of {STRUCTURED}")
+        self.mode, self.max_gestures, self.narrates = mode, int(max_gestures), mode == "narrate"
+        self.template.require("demonstrations", hint="planner=llm goes with prompt=structured or prompt=compact.")
+        self._guides = {form for name, form in GUIDES.items() if name in self.template.fields}
+        if not self._guides:
+            raise PromptError(f"{self.template.path}: planner=llm needs ${{library_guide}} or ${{library_names}}")
+        self._examples = plan_demonstrations(self.demonstrations, mode)
+        self._structured = structured_output
+        self._schema: tuple[int, dict] | None = None  # (library version, schema)
+        self.system_prompt()  # render once now, so a template error surfaces at build time
+
+    def system_prompt(self) -> str:
+        # Rendered per request from the cached guide: a variant saved after construction is offered
+        # on the very next call (library_guide re-renders when library.version changes).
+        guides = {name: library_guide(self.library, form) for name, form in GUIDES.items() if form in self._guides}
+        return self.template.render(**guides, demonstrations=self._examples, max_gestures=self.max_gestures,
+                                    mode=self.mode)
+
+    @property
+    def structured_output(self) -> str:
+        """The form actually sent (auto resolved through litellm on first use)."""
+        if self._structured == "auto":
+            self._structured = supported_structured_output(self.client.model)
+        return self._structured
+
+    def response_format(self) -> dict | None:
+        form = self.structured_output
+        if form == "none":
+            return None
+        if form == "json_object":
+            return {"type": "json_object"}
+        return {"type": "json_schema", "json_schema": {"name": "gesture_plan", "strict": True,
+                                                       "schema": self.answer_schema()}}
+
+    def answer_schema(self) -> dict:
+        """plan_schema for the library's current version (rebuilt when a motion is saved)."""
+        snapshot = self.library.snapshot
+        if self._schema is None or self._schema[0] != snapshot.version:
+            names = [n for n in snapshot.entries if n != snapshot.neutral] or list(snapshot.entries)
+            self._schema = (snapshot.version, plan_schema(names, self.max_gestures))
+        return self._schema[1]

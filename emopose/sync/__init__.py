@@ -1,0 +1,1 @@
+"""Speech-gesture sync measurement: where executed strokes land on their words, live or from a recording."""

@@ -1,0 +1,195 @@
+"""The turn runner: the one function that runs a turn, for every caller (jobs, web UI, tour, suites).
+
+It owns the planner call (always wrapped in the thinking gesture when one is configured), the stages,
+the dialogue history and the recording: a pipeline hook writes every value a stage produces to its
+MCAP channel (`/plan`, `/resolved`, ...) as `Turn.field_json` serialises it, the moment it exists.
+A scripted Plan (a suite item, a button in the web UI, a robot check) enters at the first stage that
+reads a plan, with no planner call and no JSON round trip.
+A streaming planner's reply (run_streamed) is performed sentence by sentence while the model writes:
+each sentence is a Turn of its own, recorded like any other (emopose/turn/stream_pipelines.py).
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from contextlib import ExitStack, nullcontext
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any
+
+from emopose.contract import Plan
+from emopose.llm.errors import LLMCallError
+from emopose.planners.base import Planner, PlanRequest
+from emopose.planners.streaming import SentencePlans, StreamingPlanner
+from emopose.sync.recording import TIMELINE, speech_timeline
+from emopose.turn.model import ResolvedGesture, Turn
+from emopose.turn.pipeline import Pipeline, PipelineError, Stage
+from emopose.turn.session import Session
+from emopose.turn.stream_pipelines import StreamPipelines
+from emopose.turn.thinking import ThinkingGesture
+
+
+@dataclass
+class TurnRunner:
+    planner: Planner
+    pipeline: Pipeline
+    session: Session
+    thinking: ThinkingGesture | None = None
+    history: list[dict] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._recorded = self.pipeline.with_hooks(self._recording_hook)
+        self._stream: SentencePlans | None = None  # the reply streaming now, for cancel()
+        self._stream_lock = threading.Lock()
+
+    def with_pipeline(self, pipeline: Pipeline) -> TurnRunner:
+        """The same runner (session, planner, history) running other stages: a suite's variant."""
+        return replace(self, pipeline=pipeline)
+
+    def run(self, utterance: str, image: str | bytes | None = None, *, use_history: bool = True,
+            extra_history: tuple[dict, ...] = (), planner: Planner | None = None, remember: bool = True) -> Turn:
+        """Plan and execute one utterance through the whole pipeline; it joins the dialogue history.
+
+        `planner` replaces the configured one for this turn (the tour answers visitors with a sibling);
+        `remember=False` leaves the history to the caller (the tour records what was actually said)."""
+        self.session.open()
+        history = (tuple(self.history) if use_history else ()) + tuple(extra_history)
+        turn = Turn(PlanRequest(utterance=utterance, history=history, image=image))
+        self._record(turn, "request")
+        self.plan(turn, planner or self.planner)
+        self._recorded.run(turn)
+        if remember:
+            self.history.extend([{"role": "user", "content": utterance},
+                                 {"role": "assistant", "content": turn.plan.reply}])
+        return turn
+
+    @property
+    def streams(self) -> bool:
+        """True when the configured planner speaks its replies sentence by sentence (run_streamed)."""
+        return isinstance(self.planner, StreamingPlanner) and self.planner.streams
+
+    def respond(self, utterance: str, image: str | bytes | None = None,
+                on_turn: Callable[[Turn], None] | None = None) -> StreamedReply:
+        """One reply to a person: sentence by sentence when the planner streams, else one turn."""
+        if self.streams:
+            return self.run_streamed(utterance, image, on_turn)
+        turn = self.run(utterance, image)
+        if on_turn is not None:
+            on_turn(turn)
+        return StreamedReply([turn])
+
+    def run_streamed(self, utterance: str, image: str | bytes | None = None,
+                     on_turn: Callable[[Turn], None] | None = None) -> StreamedReply:
+        """Speak the streaming planner's reply sentence by sentence as it arrives; each sentence is a Turn
+        (`on_turn` hears each once handed over). The reply joins the history as far as it was spoken."""
+        if not self.streams:
+            raise ValueError(f"planner {self.planner.name} does not stream; use planner=annotate planner.stream=true")
+        self.session.open()
+        request = PlanRequest(utterance=utterance, history=tuple(self.history), image=image)
+        plans = self.planner.stream(request)
+        with self._stream_lock:
+            self._stream, reply = plans, StreamedReply([])
+        try:
+            self._perform(request, plans, reply, on_turn or (lambda turn: None))
+        except LLMCallError as exc:  # after the first sentence: stop here, what was said stays said
+            reply.error = f"the reply stopped after {len(reply.turns)} sentence(s): {exc}"
+        finally:
+            with self._stream_lock:
+                reply.cancelled, self._stream = plans is not self._stream, None
+            plans.cancel()  # closes the HTTP stream whatever ended the loop
+        if reply.turns and not reply.cancelled and self._streamed.dispatch is not None:
+            self._streamed.dispatch.wait()
+        self.history.extend([{"role": "user", "content": utterance}, {"role": "assistant", "content": reply.text}])
+        return reply
+
+    def cancel(self) -> None:
+        """Stop the reply streaming now (an interrupt): no further sentence is performed. Any thread."""
+        with self._stream_lock:
+            plans, self._stream = self._stream, None
+        if plans is not None:
+            plans.cancel()
+
+    def _perform(self, request: PlanRequest, plans: SentencePlans, reply: StreamedReply,
+                 on_turn: Callable[[Turn], None]) -> None:
+        with ExitStack() as thinking:
+            if self.thinking is not None:
+                thinking.enter_context(self.thinking.around_planning())
+            for output in plans:
+                thinking.close()  # the first sentence is here: planning is over
+                if self._stream is not plans:
+                    return  # cancelled while this sentence was being planned
+                turn = Turn(request, planner_output=output)
+                turn.stage_s["planner"] = output.latency_s
+                self._record(turn, "request")
+                self._record(turn, "planner_output")
+                (self._streamed.rest if reply.turns else self._streamed.first).run(turn)
+                if self._stream is not plans:  # the interrupt came while this sentence was handed over
+                    self._silence()
+                    return
+                reply.turns.append(turn)
+                on_turn(turn)
+
+    def _silence(self) -> None:
+        """Undo a sentence handed over after the interrupt that should have cleared it."""
+        dispatch = self._streamed.dispatch
+        if dispatch is not None:
+            dispatch.loop.sequencer.interrupt([], now=dispatch.loop.clock.now())
+            dispatch.player.stop()
+
+    @cached_property
+    def _streamed(self) -> StreamPipelines:
+        return StreamPipelines.derive(self._recorded, self.planner.stream_preroll_s)
+
+    def run_plan(self, plan: Plan, utterance: str | None = None,
+                 resolved: list[ResolvedGesture] | None = None) -> Turn:
+        """Execute a scripted plan from the first stage that reads it; it stays out of the history.
+
+        With `resolved` (motions in no library: a Pose Studio draft) it enters at the first stage that
+        reads those, so everything after resolution (modulation, limits, the sequencer's checks) applies."""
+        self.session.open()
+        turn = Turn(PlanRequest(utterance=plan.reply if utterance is None else utterance), plan=plan,
+                    resolved=resolved)
+        entry = "plan" if resolved is None else "resolved"
+        for name in ("request", "plan") if resolved is None else ("request", "plan", "resolved"):
+            self._record(turn, name)
+        start = next((s.name for s in self.pipeline.stages if entry in s.reads), None)
+        if start is None:
+            raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} reads {entry}")
+        self._recorded.run(turn, start)
+        return turn
+
+    def plan(self, turn: Turn, planner: Planner) -> None:
+        """The planner call, wrapped in the thinking gesture that masks its latency."""
+        with self.thinking.around_planning() if self.thinking is not None else nullcontext():
+            turn.planner_output = planner.plan(turn.request)
+        turn.stage_s["planner"] = turn.planner_output.latency_s
+        self._record(turn, "planner_output")
+
+    def _recording_hook(self, stage: Stage, turn: Turn) -> None:
+        for name in stage.writes:
+            self._record(turn, name)
+        if "dispatched" in stage.writes and self.session.recording:  # enough to re-measure the sync
+            speech_start = self.session.loop.stream_time_of(turn.dispatched.speech_start)
+            self.session.write(TIMELINE, speech_timeline(turn, speech_start))
+
+    def _record(self, turn: Turn, name: str) -> None:
+        if not self.session.recording:
+            return  # serialising a turn costs more than the stage that made it
+        value: Any = turn.field_json(name)
+        self.session.write(f"/{name}", value if isinstance(value, dict) else {name: value})
+
+
+@dataclass
+class StreamedReply:
+    """A streamed reply: one Turn per sentence performed, whether an interrupt cancelled it, and the error
+    that stopped it early (None when the model finished)."""
+
+    turns: list[Turn]
+    cancelled: bool = False
+    error: str | None = None
+
+    @property
+    def text(self) -> str:
+        """What was said."""
+        return " ".join(t.plan.reply for t in self.turns if t.plan is not None and t.plan.reply)

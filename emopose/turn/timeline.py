@@ -1,0 +1,219 @@
+"""Stroke-synchronous timeline: plan a whole reply's gestures so each stroke lands on its word.
+
+BML-style sync points: every motion declares its stroke (keyframe indices, `LibraryEntry.stroke_span`).
+A gesture's stroke start must *arrive* (the arm within `tolerance` rad of the stroke-start keyframe,
+which is how it is measured) at its trigger word's onset + `lead_s`; the preparation is planned
+backwards from there. Gestures are placed in the order of their words, each against the one before:
+
+1. nominal: prepared from rest at its own speed after the previous gesture has fully retracted;
+2. co-articulated: the previous gesture is cut at its stroke end and its last stroke pose blends
+   (the paper's cubic blend) straight into this gesture's preparation, time-scaled within `scale`
+   (slower first, holding the previous stroke pose for any time left), never beyond the speed bound;
+3. shortened: as 2, cutting the previous stroke at an earlier keyframe (down to its stroke start);
+   a blend the robot's safety check would refuse (the arms would collide) is not used;
+4. retracted fast: the previous gesture returns to rest at up to `scale[0]` and this one prepares
+   from rest, time-scaled down to `scale[0]`;
+5. dropped, with the reason, when none of these fits.
+The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
+preparation needs more, it is compressed (down to `scale[0]`), then shortened to one segment straight
+to the stroke start ("direct", for strokes after several preparation keyframes), and then lands late.
+Its first segment starts from wherever the arm is at its start time; when the arm is away from rest at
+planning time (a reply interrupting motion, or the thinking gesture, which then blend back to rest), that
+segment is made long enough from the arm's pose too, so the sequencer never has to slow it down.
+`lag_s` moves everything earlier to absorb the actuators' tracking lag (0 for a command stream).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from emopose import STROKE_TOLERANCE
+from emopose.execution.trajectory import TrajectoryBuilder, blend_weight, smoothstep
+from emopose.turn.model import Fit, GestureTiming, ModulatedGesture
+
+_U = np.linspace(0.0, 1.0, 201)
+_BLEND_CURVE = blend_weight(_U)
+
+
+@dataclass(frozen=True)
+class TimelineSettings:
+    lead_s: float = -0.05
+    scale: tuple[float, float] = (0.6, 1.3)
+    max_preroll_s: float = 0.4
+    tolerance: float = STROKE_TOLERANCE
+    lag_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        low, high = self.scale
+        if not 0 < low <= 1.0 <= high:
+            raise ValueError(f"timeline scale bounds must satisfy 0 < low <= 1 <= high, got {self.scale}")
+        if self.max_preroll_s < 0 or self.tolerance <= 0:
+            raise ValueError("timeline max_preroll_s must be >= 0 and tolerance > 0")
+
+
+@dataclass
+class _Placed:
+    """A gesture being placed: its anchors (keyframe 0 = start pose) and their times (mutable: a later
+    gesture may cut it)."""
+
+    name: str
+    anchors: np.ndarray
+    stroke: tuple[int, int]
+    step: float  # nominal segment length (s)
+    times: list[float]
+    target: float
+    arrival: float
+    fit: Fit
+    blend_in: bool
+    scale: float
+    cut: int = field(default=-1)
+
+    def timing(self) -> GestureTiming:
+        keep = len(self.times) if self.cut < 0 else self.cut + 1
+        return GestureTiming(self.anchors[:keep], tuple(self.times[:keep]), self.stroke, self.target,
+                             self.arrival, self.fit, self.blend_in, self.scale, cut=self.cut >= 0)
+
+
+class TimelinePlanner:
+    def __init__(self, builder: TrajectoryBuilder, settings: TimelineSettings,
+                 safety: Callable[[np.ndarray], str | None] | None = None) -> None:
+        self.builder = builder
+        self.settings = settings
+        self.safety = safety  # the sequencer's pre-dispatch check, applied to co-articulation blends
+        knots = np.arange(builder.increments + 1) / builder.increments
+        self._smooth_curve = np.interp(_U, knots, smoothstep(knots))  # the waypoint easing G samples
+
+    def plan(self, gestures: list[ModulatedGesture], onsets: list[float],
+             arm: np.ndarray | None = None) -> tuple[list[GestureTiming | str], float]:
+        """Timing (or a drop reason) per gesture, in the given order, and the speech pre-roll (s).
+        `arm`: the arm's pose now, if it may not be at rest when the first gesture starts."""
+        out: list[GestureTiming | str] = [""] * len(gestures)
+        placed: list[tuple[int, _Placed]] = []
+        for k in sorted(range(len(gestures)), key=lambda k: onsets[k]):
+            aim = onsets[k] + self.settings.lead_s - self.settings.lag_s
+            gesture = self._place(gestures[k], aim, placed[-1][1] if placed else None, arm)
+            if isinstance(gesture, str):
+                out[k] = gesture
+            else:
+                placed.append((k, gesture))
+        for k, gesture in placed:
+            out[k] = gesture.timing()
+        preroll = max(0.0, -min((g.times[0] for _, g in placed), default=0.0))
+        return out, preroll
+
+    # -- placing one gesture -------------------------------------------------------------------------
+    def _place(self, gesture: ModulatedGesture, aim: float, prev: _Placed | None,
+               arm: np.ndarray | None) -> _Placed | str:
+        anchors, stroke, step = self._shape(gesture)
+        low, high = self.settings.scale
+        name = gesture.name
+        if prev is None:
+            # origins stacked (m, 14): segment bounds and approach distances take the farthest one; a
+            # blend from `arm` back to rest stays between the two, so both bounds cover it
+            origins = anchors[:1] if arm is None else np.vstack([anchors[0], arm])
+            earliest = -self.settings.max_preroll_s
+            placed = self._prepare(name, anchors, stroke, step, origins, False, earliest, aim, (1.0, low))
+            return placed or self._late(name, anchors, stroke, step, origins, earliest, aim)
+        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, prev.times[-1], aim, (1.0, 1.0))
+        if placed is not None:
+            return placed
+        unsafe = ""
+        for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
+            placed = self._prepare(name, anchors, stroke, step, prev.anchors[cut], True, prev.times[cut], aim,
+                                   (high, low))
+            if placed is None:
+                continue  # cutting earlier in the stroke leaves more time
+            unsafe = self._unsafe(placed, prev.anchors[cut])
+            if not unsafe:
+                prev.cut = cut
+                placed.fit = "coarticulated" if cut == prev.stroke[1] else "shortened"
+                return placed
+        retraction = self._retract(prev, low)
+        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, retraction[-1], aim, (1.0, low))
+        if placed is not None:
+            prev.times[prev.stroke[1]:] = retraction
+            return placed
+        room = aim - prev.times[prev.stroke[0]]
+        why = f"blending from {prev.name} is unsafe ({unsafe})" if unsafe else (
+            f"too little to prepare at {low:g}x and the joint speed bound")
+        return f"no room: its stroke is {room * 1e3:.0f} ms after {prev.name}'s stroke start; {why}"
+
+    def _unsafe(self, placed: _Placed, start_pose: np.ndarray) -> str:
+        """Why the co-articulated preparation would fail the robot's safety check ("" if it passes)."""
+        if self.safety is None:
+            return ""
+        end = placed.stroke[0]
+        times = np.asarray(placed.times[1:end + 1]) - placed.times[0]
+        motion = self.builder.build_timed(placed.anchors[:end + 1], times, start_pose, blend_in=True)
+        return self.safety(motion.samples) or ""
+
+    def _retract(self, prev: _Placed, scale: float) -> list[float]:
+        """prev's keyframe times from its stroke end on, with the retraction time-scaled."""
+        end = prev.stroke[1]
+        durations = self._durations(prev.anchors, prev.anchors[0], end, len(prev.anchors) - 1, prev.step * scale,
+                                    False)
+        return np.cumsum([prev.times[end], *durations]).tolist()
+
+    @staticmethod
+    def _shape(gesture: ModulatedGesture) -> tuple[np.ndarray, tuple[int, int], float]:
+        """Anchors (a pose becomes start -> pose), stroke indices and the nominal segment length."""
+        q = np.asarray(gesture.keyframes, dtype=float)
+        if len(q) == 1:
+            return np.vstack([q, q]), (1, 1), gesture.duration
+        return q, gesture.resolved.entry.stroke_span, gesture.duration / (len(q) - 1)
+
+    def _prepare(self, name, anchors, stroke, step, start_pose, blend_in, earliest, aim, scales) -> _Placed | None:
+        """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
+        to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
+        start; None if even that would need to start before `earliest`."""
+        shapes = [(anchors, stroke, None)]
+        if stroke[0] >= 2:  # skip the intermediate preparation keyframes
+            shapes.append((np.vstack([anchors[:1], anchors[stroke[0]:]]), (1, stroke[1] - stroke[0] + 1), "direct"))
+        grid = np.arange(scales[0], scales[1] - 1e-9, -0.05).tolist() + [scales[1]]
+        for shape, sync, how in shapes:
+            for scale in np.unique(np.clip(grid, scales[1], scales[0]))[::-1]:
+                durations = self._durations(shape, start_pose, 0, sync[0], step * scale, blend_in)
+                arrival_lead = self._approach(start_pose if sync[0] == 1 else shape[sync[0] - 1],
+                                              shape[sync[0]], durations[-1], blend_in and sync[0] == 1)
+                start = aim + arrival_lead - sum(durations)
+                if start >= earliest - 1e-9:
+                    fit: Fit = how or ("nominal" if scale == 1.0 else "scaled")
+                    return self._finish(name, shape, sync, step, start_pose, start, durations, aim, aim, fit,
+                                        blend_in, float(scale))
+        return None
+
+    def _late(self, name, anchors, stroke, step, origins, start, aim) -> _Placed:
+        """The first gesture when even the pre-roll and the fastest preparation cannot meet its word."""
+        low = self.settings.scale[0]
+        durations = self._durations(anchors, origins, 0, stroke[0], step * low, False)
+        before = origins if stroke[0] == 1 else anchors[stroke[0] - 1]
+        arrival = start + sum(durations) - self._approach(before, anchors[stroke[0]], durations[-1], False)
+        return self._finish(name, anchors, stroke, step, origins, start, durations, aim, arrival, "late",
+                            False, low)
+
+    def _finish(self, name, anchors, stroke, step, start_pose, start, prep, aim, arrival, fit, blend_in,
+                scale) -> _Placed:
+        rest = self._durations(anchors, start_pose, stroke[0], len(anchors) - 1, step, False)
+        times = np.cumsum([start, *prep, *rest]).tolist()
+        return _Placed(name, anchors, stroke, step, times, aim, arrival, fit, blend_in, scale)
+
+    def _durations(self, anchors, start_pose, first, last, length, blend_in) -> list[float]:
+        """Segment durations from keyframe `first` to `last`, each at least its speed-bound minimum."""
+        out = []
+        for i in range(first + 1, last + 1):
+            origin = start_pose if i == 1 else anchors[i - 1]
+            out.append(max(length, self.builder.segment_minimum(origin, anchors[i], blend_in and i == 1),
+                           self.builder.dt))
+        return out
+
+    def _approach(self, q_from: np.ndarray, q_to: np.ndarray, duration: float, blend: bool) -> float:
+        """How long before the end of a segment the arm comes within the tolerance of its target."""
+        distance = float(np.max(np.abs(q_to - q_from)))
+        if distance <= self.settings.tolerance:
+            return duration
+        curve = _BLEND_CURVE if blend else self._smooth_curve
+        u = float(np.interp(1.0 - self.settings.tolerance / distance, curve, _U))
+        return duration * (1.0 - u)
