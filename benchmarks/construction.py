@@ -34,21 +34,21 @@ from emopose.clock import FakeClock
 from emopose.contract import GestureRecord
 from emopose.execution.control_loop import ControlLoop
 from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.sequencer import Sequencer
+from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.library import MotionLibrary
 from emopose.robot.collision import SelfCollisionChecker
-from emopose.execution.sequencer import Sequencer
 from emopose.stages.modulate import modulate_keyframes
-from emopose.turn.timeline import TimelinePlanner, TimelineSettings
-from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.turn.model import ModulatedGesture, ResolvedGesture
+from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 
 LIBRARY = Path(__file__).resolve().parents[1] / "library" / "g1"
 
 
 def stats(seconds: list[float]) -> dict:
     ms = np.asarray(seconds) * 1e3
-    return {"mean": float(ms.mean()), "p50": float(np.percentile(ms, 50)), "p95": float(np.percentile(ms, 95)),
-            "max": float(ms.max()), "n": int(ms.size)}
+    return {"mean": float(ms.mean()), "p50": float(np.percentile(ms, 50)),
+            "p95": float(np.percentile(ms, 95)), "max": float(ms.max()), "n": int(ms.size)}
 
 
 def timed(fn, *args) -> tuple[float, object]:
@@ -61,14 +61,16 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--repeats", type=int, default=20)
     parser.add_argument("--library", default=str(LIBRARY))
-    parser.add_argument("--rt-priority", type=int, default=0, help="SCHED_FIFO priority (0 = normal scheduling)")
+    parser.add_argument("--rt-priority", type=int, default=0,
+                        help="SCHED_FIFO priority (0 = normal scheduling)")
     args = parser.parse_args()
     scheduling = realtime_priority(args.rt_priority)
     library = MotionLibrary.from_config(paths=[args.library], limits=str(Path(args.library) / "limits.yaml"))
     builder, checker = TrajectoryBuilder(library.limits), SelfCollisionChecker()
     neutral = library.neutral_entry.q[0]
     cases = [(e, level, modulate_keyframes(e.q, level, library.limits))
-             for e in library.snapshot.entries.values() if e.motion_type == "sequence" for level in range(1, 6)]
+             for e in library.snapshot.entries.values() if e.motion_type == "sequence"
+             for level in range(1, 6)]
     build_s, check_s, per_motion = [], [], {}
     gc.disable()  # a collection pause is not construction time; reported separately below if it mattered
     for entry, _level, keyframes in cases:
@@ -85,7 +87,8 @@ def main() -> None:
         (timing,), _ = planner.plan([gesture], [1.0])
         times = np.asarray(timing.times[1:]) - timing.times[0]
         builder.build_timed(timing.keyframes, times, neutral)  # warm-up
-        timed_s += [timed(builder.build_timed, timing.keyframes, times, neutral)[0] for _ in range(args.repeats)]
+        timed_s += [timed(builder.build_timed, timing.keyframes, times, neutral)[0]
+                    for _ in range(args.repeats)]
     # Submission: the hand-off into the queue, with a loop ticking between submissions as in a session.
     sequencer = Sequencer(builder, neutral)
     loop = ControlLoop(sequencer, DryRunBackend(), FakeClock())

@@ -29,9 +29,9 @@ from emopose import CONTROL_DT
 from emopose.clock import MonotonicClock
 from emopose.execution.control_loop import ControlLoop
 from emopose.execution.gesture_command import GestureCommand
-from emopose.library import MotionLibrary
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.library import MotionLibrary
 
 LIBRARY = Path(__file__).resolve().parents[1] / "library" / "g1"
 
@@ -83,8 +83,8 @@ def run(backend_name: str, seconds: float, library: MotionLibrary) -> dict:
     work_ms = (done_at - woke) * 1e3
     return {
         "backend": backend_name, "seconds": seconds, "ticks": ticks,
-        "period_error_ms": {"p50": float(np.percentile(period_ms, 50)), "p99": float(np.percentile(period_ms, 99)),
-                            "max": float(period_ms.max())},
+        "period_error_ms": {"p50": float(np.percentile(period_ms, 50)),
+                            "p99": float(np.percentile(period_ms, 99)), "max": float(period_ms.max())},
         "lateness_ms": {"p50": float(np.percentile(late_ms, 50)), "p99": float(np.percentile(late_ms, 99)),
                         "max": float(late_ms.max())},
         "cumulative_drift_ms": float(late_ms[-1]),
@@ -92,7 +92,8 @@ def run(backend_name: str, seconds: float, library: MotionLibrary) -> dict:
         "work_ms": {"p50": float(np.percentile(work_ms, 50)), "p99": float(np.percentile(work_ms, 99)),
                     "max": float(work_ms.max())},
         "missed_deadlines": int(np.sum(done_at > ideal + CONTROL_DT)),
-        "loop_missed_deadlines": loop.stats.missed_deadlines,  # deadlines ControlLoop skipped after falling behind
+        # deadlines ControlLoop skipped after falling behind
+        "loop_missed_deadlines": loop.stats.missed_deadlines,
         "motions_started": sum(e.kind == "started" for e in sequencer.events),
     }
 
@@ -113,7 +114,8 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=60.0)
     parser.add_argument("--backends", nargs="+", default=["dry_run", "mujoco"], choices=["dry_run", "mujoco"])
     parser.add_argument("--library", default=str(LIBRARY))
-    parser.add_argument("--rt-priority", type=int, default=0, help="SCHED_FIFO priority (0 = normal scheduling)")
+    parser.add_argument("--rt-priority", type=int, default=0,
+                        help="SCHED_FIFO priority (0 = normal scheduling)")
     args = parser.parse_args()
     library = MotionLibrary.from_config(paths=[args.library], limits=str(Path(args.library) / "limits.yaml"))
     scheduling = realtime_priority(args.rt_priority)

@@ -116,7 +116,8 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=60.0, help="length of the 50 Hz run")
     parser.add_argument("--messages", type=int, default=5000, help="messages for the latency run")
     parser.add_argument("--domain-id", type=int, default=random.SystemRandom().randint(20, 230))
-    parser.add_argument("--arm-law", default="robot", help="conf/arm_law/<name>.yaml: the gains and feed-forwards sent")
+    parser.add_argument("--arm-law", default="robot",
+                        help="conf/arm_law/<name>.yaml: the gains and feed-forwards sent")
     args = parser.parse_args()
     law = OmegaConf.load(REPO / "conf" / "arm_law" / f"{args.arm_law}.yaml")
     fake = start_fake(args.domain_id)

@@ -33,6 +33,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 from conftest import load_library, make_library_dir
 from planners.fake_answers import FAULTS, PLAN, UNUSABLE
 
+from emopose.llm.client import LLMClient
 from emopose.planners.base import PlanRequest, plan_all
 from emopose.planners.chat.llm import LLMPlanner
 from emopose.stages.parse import parse_output
@@ -73,7 +74,8 @@ def main() -> None:
     parser.add_argument("--max-retries", type=int, default=3)
     parser.add_argument("--backoff", type=float, default=1.0, help="first backoff, s (planner default 1.0)")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--model", default="openai/gpt-4o-mini", help="any litellm model string; served by the fake")
+    parser.add_argument("--model", default="openai/gpt-4o-mini",
+                        help="any litellm model string; served by the fake")
     parser.add_argument("--target-s", type=float, default=15.0)
     parser.add_argument("--mix", nargs="+", default=["malformed", "http_500"], choices=sorted(FAULTS))
     args = parser.parse_args()
@@ -84,9 +86,9 @@ def main() -> None:
         library = load_library(make_library_dir(Path(tmp) / "library"))
         planner = LLMPlanner(library=library, template=str(ROOT / "prompts/structured.md"),
                              demonstrations=str(ROOT / "prompts/demonstrations.jsonl"),
-                             model=args.model, api_base=url, cache=False,
-                             concurrency=args.concurrency, max_retries=args.max_retries,
-                             backoff_s=args.backoff, timeout_s=10.0)
+                             client=LLMClient(model=args.model, api_base=url, cache=False,
+                                              concurrency=args.concurrency, max_retries=args.max_retries,
+                                              backoff_s=args.backoff, timeout_s=10.0))
         requests = [PlanRequest(f"Item {k}: the charging dock is over there by the window.")
                     for k in range(args.requests)]
         planner.plan(requests[0])  # warm-up outside the timing: litellm's lazy imports take seconds

@@ -45,11 +45,12 @@ def _cpu_s() -> float:
 
 
 def cli(run_dir: Path, *overrides: str) -> tuple[int, float, float, str]:
-    """(exit code, wall s, CPU s of the process: the load-independent part on a shared machine, last stderr line)."""
+    """(exit code, wall s, CPU s of the process: the load-independent part on a shared machine,
+    last stderr line)."""
     env = {**os.environ, "HYDRA_FULL_ERROR": "1", "LITELLM_LOCAL_MODEL_COST_MAP": "True"}
     started, cpu = time.perf_counter(), _cpu_s()
     done = subprocess.run([sys.executable, "-m", "emopose", "+experiment=bench_all", "planner=llm",
-                           "planner.cache=false", "job.progress=false", "run.record=false",
+                           "planner.client.cache=false", "job.progress=false", "run.record=false",
                            f"hydra.run.dir={run_dir}", *overrides],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
     last = (done.stderr.strip().splitlines() or [""])[-1]
@@ -60,9 +61,9 @@ def prompt_sizes() -> dict:
     from hydra import compose, initialize_config_dir
     from hydra.utils import instantiate
 
+    from emopose.llm.check import prompt_tokens
     from emopose.planners.base import PlanRequest
     from emopose.planners.chat.planner import PROBE_LINE
-    from emopose.llm.check import prompt_tokens
 
     register_resolvers()
     sizes = {}
@@ -78,18 +79,22 @@ def prompt_sizes() -> dict:
 
 def main() -> None:
     server = subprocess.Popen([sys.executable, str(FAKE_SERVER), "--api-key", KEY, "--models", MODEL,
-                               "--context-window", str(WINDOW)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                               "--context-window", str(WINDOW)],
+                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
     try:
         url = json.loads(server.stdout.readline())["url"]
-        good = [f"planner.api_base={url}", f"planner.api_key={KEY}", f"planner.model=openai/{MODEL}"]
+        good = [f"planner.client.api_base={url}", f"planner.client.api_key={KEY}",
+                f"planner.client.model=openai/{MODEL}"]
         cases = {
-            "dead_endpoint": ([f"planner.api_base=http://127.0.0.1:{free_port()}/v1", *good[1:], "prompt=compact"],
-                              "nothing answers"),
-            "wrong_key": ([*good, "planner.api_key=sk-wrong", "prompt=compact"], "rejected the API key"),
-            "unknown_model": ([*good, "planner.model=openai/no-such-model", "prompt=compact"], "does not know model"),
+            "dead_endpoint": ([f"planner.client.api_base=http://127.0.0.1:{free_port()}/v1", *good[1:],
+                               "prompt=compact"], "nothing answers"),
+            "wrong_key": ([*good, "planner.client.api_key=sk-wrong", "prompt=compact"],
+                          "rejected the API key"),
+            "unknown_model": ([*good, "planner.client.model=openai/no-such-model", "prompt=compact"],
+                              "does not know model"),
             "context_overflow": (good, "context window"),
-            "control_compact": ([*good, "prompt=compact", f"bench.path={FIXTURE}", "planner.temperature=0",
-                                 "job.confusion=false"], None),
+            "control_compact": ([*good, "prompt=compact", f"bench.path={FIXTURE}",
+                                 "planner.client.temperature=0", "job.confusion=false"], None),
         }
         report = {}
         with tempfile.TemporaryDirectory() as tmp:
@@ -97,7 +102,8 @@ def main() -> None:
                 run_dir = Path(tmp) / name
                 rc, wall, cpu, last = cli(run_dir, *overrides)
                 scored = (run_dir / "results.json").exists()
-                ok = rc == 0 and scored if cause is None else rc == 2 and cause in last and not scored and wall <= TARGET_S
+                ok = (rc == 0 and scored if cause is None
+                      else rc == 2 and cause in last and not scored and wall <= TARGET_S)
                 report[name] = {"exit": rc, "wall_s": round(wall, 2), "cpu_s": round(cpu, 2),
                                 "stderr_last_line": last[:300],
                                 "results_written": scored, "meets_target": ok}

@@ -27,6 +27,7 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "tests" / "planners")
 from conftest import load_library, make_library_dir
 from fake_openai import Answer, FakeOpenAI, slow
 
+from emopose.llm.client import LLMClient
 from emopose.planners.base import PlanRequest, plan_all
 from emopose.planners.chat.llm import LLMPlanner
 
@@ -57,8 +58,9 @@ def main() -> None:
 
         def planner(**settings) -> LLMPlanner:
             return LLMPlanner(library=library, template=str(ROOT / "prompts/structured.md"),
-                              demonstrations=str(ROOT / "prompts/demonstrations.jsonl"), model="openai/fake-model",
-                              api_base=server.url, cache=False, backoff_s=0.001, backoff_max_s=0.01, **settings)
+                              demonstrations=str(ROOT / "prompts/demonstrations.jsonl"),
+                              client=LLMClient(model="openai/fake-model", api_base=server.url, cache=False,
+                                               backoff_s=0.001, backoff_max_s=0.01, **settings))
 
         planner().plan(PlanRequest("Warm-up: hello there."))
         waves = planner(concurrency=args.concurrency, timeout_s=10.0)
@@ -68,8 +70,8 @@ def main() -> None:
                             **timed(lambda: plan_all(waves, requests), args.repeats, 1.5)}}
         server.default = slow(3.0)
         patient = planner(timeout_s=0.3, max_retries=1)
-        report["timeout"] = timed(lambda: patient.plan(PlanRequest("Hello there, welcome aboard!")), args.repeats,
-                                  2.5)
+        report["timeout"] = timed(lambda: patient.plan(PlanRequest("Hello there, welcome aboard!")),
+                                  args.repeats, 2.5)
     print(json.dumps(report, indent=2))
 
 

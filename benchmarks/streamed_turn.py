@@ -71,8 +71,9 @@ def start_server(first_token_s: float, tokens_per_s: float) -> tuple[subprocess.
 
 def build(url: str, annotator: str, preroll_s: float | None, run_dir: Path):
     preroll = [] if preroll_s is None else [f"planner.stream_preroll_s={preroll_s}"]
-    cfg = compose_config([*preroll, "+experiment=serve", "planner=annotate", "planner.stream=true", "planner.model=openai/bench", f"planner.api_base={url}",
-                          "planner.cache=false", "player=none", "tts=espeak", "tts.write_audio=false",
+    cfg = compose_config([*preroll, "+experiment=serve", "planner=annotate", "planner.stream=true",
+                          "planner.client.model=openai/bench", f"planner.client.api_base={url}",
+                          "planner.client.cache=false", "player=none", "tts=espeak", "tts.write_audio=false",
                           f"tts.audio_dir={run_dir / 'tts'}", "backend=dry_run", "run.record=false"])
     run = build_run(cfg, run_dir)
     if annotator == "keyword":
@@ -145,7 +146,8 @@ def main() -> None:
     keys = [k for k in rows[0] if k != "sentences"]
     report = {
         "server": {"first_token_s": args.first_token_s, "tokens_per_s": args.tokens_per_s},
-        "annotator": args.annotator, "stream_preroll_s": run.runner.planner.stream_preroll_s, "repeats": args.repeats, "sentences": rows[0]["sentences"],
+        "annotator": args.annotator, "stream_preroll_s": run.runner.planner.stream_preroll_s,
+        "repeats": args.repeats, "sentences": rows[0]["sentences"],
         "streamed": {k: stats([r[k] for r in rows]) for k in keys},
         "speech_start_minus_first_sentence": stats(margin),
         "unstreamed_speech_start": stats(whole),

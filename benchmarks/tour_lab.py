@@ -37,10 +37,12 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as run_dir:
         results = run(cfg, Path(run_dir))
     wall_s, sim_s = results["wall_time_s"], results["sim_time_s"]
-    print(json.dumps({"overrides": args.overrides, "wall_time_s": round(wall_s, 1), "sim_time_s": round(sim_s, 1),
-                      "realtime_factor": round(sim_s / wall_s, 2), "target_wall_s": TARGET_WALL_S,
+    print(json.dumps({"overrides": args.overrides, "wall_time_s": round(wall_s, 1),
+                      "sim_time_s": round(sim_s, 1), "realtime_factor": round(sim_s / wall_s, 2),
+                      "target_wall_s": TARGET_WALL_S,
                       "within_target": wall_s <= TARGET_WALL_S and sim_s > wall_s,
-                      "stops_reached": results["stops_reached"], "load_avg_1min": round(os.getloadavg()[0], 2)},
+                      "stops_reached": results["stops_reached"],
+                      "load_avg_1min": round(os.getloadavg()[0], 2)},
                      indent=2))
 
 

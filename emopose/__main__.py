@@ -11,7 +11,7 @@ from omegaconf import DictConfig
 from emopose import app
 from emopose.build import ConfigError
 from emopose.config import register_resolvers
-from emopose.library import LibraryError
+from emopose.joint_limits import LibraryError
 from emopose.planners.base import PlannerFailure
 from emopose.robot.model import ModelError
 from emopose.stop_signals import exit_status, signal_name, sigterm_interrupts
@@ -29,7 +29,8 @@ def main(cfg: DictConfig) -> None:
         print(f"error: {exc}", file=sys.stderr)
         sys.exit(2)
     except KeyboardInterrupt as interrupt:
-        print(f"interrupted by {signal_name(interrupt)}: robot released, recording closed; results in {run_dir}",
+        print(f"interrupted by {signal_name(interrupt)}: robot released, recording closed; "
+              f"results in {run_dir}",
               file=sys.stderr)
         sys.exit(exit_status(interrupt))
 

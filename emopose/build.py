@@ -14,12 +14,13 @@ from pathlib import Path
 from typing import Any
 
 from hydra.errors import InstantiationException
-from hydra.utils import get_class, instantiate
+from hydra.utils import get_object, instantiate
 from omegaconf import DictConfig, OmegaConf
 
-from emopose.clock import FakeClock, MonotonicClock
+from emopose.clock import clock_for
 from emopose.execution.control_loop import ControlLoop
 from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.planners.base import CheckedPlanner, Planner
 from emopose.resources import Resources, Run
 from emopose.scene.view import SceneSlot
 from emopose.speech.player import Player
@@ -39,8 +40,8 @@ def make(node: Any, key: str, **kwargs: Any) -> Any:
     try:
         if not kwargs:
             return instantiate(node, _convert_="all")
-        # Runtime objects go straight to the factory: instantiate(node, **kwargs) would merge them into the
-        # config, and OmegaConf turns a dataclass instance (MotionLibrary, TrajectoryBuilder) into a config node.
+        # Runtime objects go straight to the factory: instantiate(node, **kwargs) would merge them into
+        # the config, and OmegaConf turns a dataclass (MotionLibrary, TrajectoryBuilder) into a config node.
         factory = instantiate(node, _convert_="all", _partial_=True)
         return factory(**kwargs)
     except (InstantiationException, TypeError, ValueError) as exc:  # a bad value the target rejected
@@ -53,14 +54,14 @@ def make_with(node: Any, key: str, resources: dict[str, Any]) -> Any:
     if node is None or "_target_" not in node:
         return None
     try:
-        wanted = inspect.signature(get_class(node._target_)).parameters
+        wanted = inspect.signature(get_object(node._target_)).parameters
     except Exception as exc:  # an unknown or unimportable _target_
         raise ConfigError(f"cannot build '{key}': {exc}") from exc
     return make(node, key, **{name: value for name, value in resources.items() if name in wanted})
 
 
 def ordered_stages(pipeline: DictConfig) -> dict[str, Any]:
-    """The stage nodes in `pipeline.order`, with each `pipeline.insert_after` stage placed after its anchor."""
+    """The stage nodes in `pipeline.order`, each `pipeline.insert_after` stage placed after its anchor."""
     order = list(pipeline.order)
     for name, anchor in (pipeline.get("insert_after") or {}).items():
         if anchor not in order:
@@ -86,32 +87,34 @@ def safety_check(checker: Any):
     return check
 
 
-def check_planner(planner: Any) -> None:
+def check_planner(planner: Planner) -> None:
     """Planners that call a service say what is missing (key, model string) before any run starts."""
-    check = getattr(planner, "check", None)
-    if check is None:
+    if not isinstance(planner, CheckedPlanner):
         return
     try:
-        check()
+        planner.check()
     except ValueError as exc:
         raise ConfigError(f"planner: {exc}") from exc
 
 
 def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
     library = make(cfg.library, "library")
-    planner = make(cfg.planner, "planner", library=library)
+    planner = make_with(cfg.planner, "planner", {"library": library})
     check_planner(planner)
     backend = make(cfg.backend, "backend")
-    realtime = cfg.run.clock == "monotonic" or (cfg.run.clock == "auto" and backend.realtime)
-    clock = MonotonicClock() if realtime else FakeClock()
+    try:
+        clock = clock_for(cfg.run.clock, backend.realtime)
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from exc
     safety = safety_check(make(cfg.safety, "safety"))
     sequencer = make(cfg.sequencer, "sequencer", builder=TrajectoryBuilder(library.limits),
                      neutral=library.neutral_entry.q[0], safety=safety)
     loop = ControlLoop(sequencer, backend, clock)
     player = make(cfg.get("player"), "player") or Player(sink="none")
     synthesizer, scene = make(cfg.tts, "tts"), SceneSlot()
-    shared = {"library": library, "limits": library.limits, "synthesizer": synthesizer, "sequencer": sequencer,
-              "clock": clock, "loop": loop, "player": player, "scene": scene, "safety": safety}
+    shared = {"library": library, "limits": library.limits, "synthesizer": synthesizer,
+              "sequencer": sequencer, "clock": clock, "loop": loop, "player": player, "scene": scene,
+              "safety": safety}
     stages = {name: make_with(node, f"pipeline.stages.{name}", shared)
               for name, node in ordered_stages(cfg.pipeline).items()}
     try:

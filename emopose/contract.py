@@ -7,6 +7,7 @@ The model never supplies a joint value: `LibraryEntry.keyframes` only ever come 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from enum import StrEnum
 from typing import Literal
 
 import numpy as np
@@ -26,6 +27,23 @@ PlanSource = Literal["model", "retried", "scripted", "plain_text", "empty", "unk
 USABLE_SOURCES = frozenset({"model", "retried", "scripted"})
 
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
+# The longest reply a plan carries: the parser cuts a model's JSON reply (and each record's text) to it,
+# and the tour plans a longer line in pieces of whole sentences under it.
+MAX_REPLY_CHARS = 200
+
+
+class EventKind(StrEnum):
+    """What the sequencer reports of a gesture (emopose/execution/sequencer.py); recordings
+    (/sequencer/events), Turn.to_json and the sync measurement keep the string values."""
+
+    STARTED = "started"
+    STROKE = "stroke"  # the arm reached the stroke
+    COMPLETED = "completed"
+    CUT = "cut"  # ended after its stroke: co-articulated into, or preempted by, the next gesture
+    STOPPED = "stopped"  # interrupted, or cut short by an overdue successor
+    REJECTED = "rejected"  # refused by the safety check
+    DROPPED = "dropped"  # the timeline could not fit it
+    STATE = "state"  # the sequencer's state changed (detail: the new state)
 
 
 def trigger_position(reply: str, trigger: str | None) -> int | None:
@@ -96,7 +114,8 @@ MotionType = Literal["sequence", "pose"]
 
 
 class LibraryEntry(BaseModel):
-    """One robot-owned motion l_n = (name, class, keyframes Q, duration d, motion type m) (paper Eq. library)."""
+    """One robot-owned motion l_n = (name, class, keyframes Q, duration d, motion type m)
+    (paper Eq. library)."""
 
     model_config = ConfigDict(frozen=True, populate_by_name=True, extra="forbid")
 
@@ -128,7 +147,8 @@ class LibraryEntry(BaseModel):
             raise ValueError(f"a pose has exactly 1 keyframe, got {k}")
         if self.motion_type == "sequence" and not MIN_KEYFRAMES <= k <= MAX_KEYFRAMES:
             raise ValueError(
-                f"a sequence needs {MIN_KEYFRAMES}..{MAX_KEYFRAMES} keyframes (at least one interior), got {k}"
+                f"a sequence needs {MIN_KEYFRAMES}..{MAX_KEYFRAMES} keyframes "
+                f"(at least one interior), got {k}"
             )
         self._q = np.asarray(self.keyframes, dtype=float)
         self._q.setflags(write=False)

@@ -1,4 +1,4 @@
-"""The robot-owned motion library: joint limits, motion files, class defaults and the planner's guide.
+"""The robot-owned motion library: motion files, class defaults and the planner's guide.
 
 A library set is a folder of YAML files, one motion per file (see library/README.md). Loading
 validates every file once and names the file, the entry and the field in any error. The library is
@@ -16,69 +16,14 @@ import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import yaml
 from pydantic import ValidationError
 
-from emopose import CLASSES, NUM_JOINTS
+from emopose import CLASSES
 from emopose.contract import LibraryEntry
+from emopose.joint_limits import JointLimits, LibraryError
 
 log = logging.getLogger(__name__)
-
-class LibraryError(ValueError):
-    """A library file or library configuration is invalid; the message says where and how to fix it."""
-
-
-@dataclass(frozen=True)
-class JointLimits:
-    """Hard joint limits q-, q+ (rad) and speed bounds (rad/s), in the library's 14-joint order."""
-
-    names: tuple[str, ...]
-    lower: np.ndarray
-    upper: np.ndarray
-    max_velocity: np.ndarray
-
-    @classmethod
-    def from_file(cls, path: str | Path) -> JointLimits:
-        path = Path(path)
-        try:
-            raw = yaml.safe_load(path.read_text())
-            names = tuple(raw["joints"])
-            lower, upper = (np.asarray(raw[k], dtype=float) for k in ("lower", "upper"))
-            velocity = np.broadcast_to(np.asarray(raw.get("max_velocity", 6.0), dtype=float), (NUM_JOINTS,))
-        except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
-            raise LibraryError(f"{path}: cannot read joint limits ({exc!r}); need joints, lower, upper") from exc
-        if not (len(names) == lower.size == upper.size == NUM_JOINTS):
-            raise LibraryError(f"{path}: joints, lower and upper must each list {NUM_JOINTS} values")
-        if np.any(lower >= upper):
-            bad = [names[j] for j in np.flatnonzero(lower >= upper)]
-            raise LibraryError(f"{path}: lower must be below upper for {bad}")
-        return cls(names, lower, upper, velocity.copy())
-
-    def project(self, q: np.ndarray, margin: float = 0.0) -> np.ndarray:
-        """Pi_j: clip into [q- + margin, q+ - margin] joint-wise; works on (14,) or (T, 14)."""
-        return np.clip(q, self.lower + margin, self.upper - margin)
-
-    def _outside(self, q: np.ndarray, margin: float) -> np.ndarray:
-        """(T, 14) mask: where q leaves [q- + margin, q+ - margin]."""
-        return (q < self.lower + margin) | (q > self.upper - margin)
-
-    def violations(self, q: np.ndarray, margin: float = 0.0) -> list[str]:
-        """Names of joints that leave [q- + margin, q+ - margin] anywhere in q ((14,) or (T, 14))."""
-        bad = np.any(self._outside(np.atleast_2d(q), margin), axis=0)
-        return [self.names[j] for j in np.flatnonzero(bad)]
-
-    def violation_details(self, q: np.ndarray, margin: float = 0.0) -> list[str]:
-        """One line per offending joint of (K, 14) keyframes: its worst keyframe, value and allowed range."""
-        q = np.atleast_2d(q)
-        low, high = self.lower + margin, self.upper - margin
-        excess = np.maximum(low - q, q - high)  # > 0 outside
-        out = []
-        for j in np.flatnonzero(np.any(self._outside(q, margin), axis=0)):
-            k = int(np.argmax(excess[:, j]))
-            out.append(f"{self.names[j]} = {q[k, j]:.3f} rad in keyframe {k} (allowed {low[j]:.3f}..{high[j]:.3f})")
-        return out
-
 
 @dataclass(frozen=True)
 class LibrarySnapshot:
@@ -174,7 +119,8 @@ class MotionLibrary:
                     continue
                 entry = self._load_file(path)
                 if entry.name in entries:
-                    raise LibraryError(f"{path}: motion name '{entry.name}' is already defined in {files[entry.name]}")
+                    raise LibraryError(f"{path}: motion name '{entry.name}' is already defined in "
+                                       f"{files[entry.name]}")
                 entries[entry.name] = entry
                 files[entry.name] = path
         with self._lock:
@@ -189,7 +135,8 @@ class MotionLibrary:
             raise LibraryError(f"{path}: not readable YAML ({exc})") from exc
         entry = self.validate(raw, source=str(path))
         if entry.stroke is None and entry.motion_type == "sequence":
-            log.warning("%s: no `stroke: [start, end]`; using the largest-excursion keyframe %s as the stroke",
+            log.warning("%s: no `stroke: [start, end]`; "
+                        "using the largest-excursion keyframe %s as the stroke",
                         path, list(entry.stroke_span))
         return entry
 
@@ -201,19 +148,23 @@ class MotionLibrary:
             entry = LibraryEntry.model_validate(raw)
         except ValidationError as exc:
             name = raw.get("name", "?")
-            problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'entry'}: {e['msg']}" for e in exc.errors())
+            problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'entry'}: {e['msg']}"
+                                 for e in exc.errors())
             raise LibraryError(f"{source}: motion '{name}': {problems}") from exc
         bad = self.limits.violation_details(entry.q, self.limit_margin)
         if bad:
             raise LibraryError(
-                f"{source}: motion '{entry.name}': keyframes leave the joint limits (kept {self.limit_margin} rad "
+                f"{source}: motion '{entry.name}': keyframes leave the joint limits "
+                f"(kept {self.limit_margin} rad "
                 f"inside the limits file's range): {'; '.join(bad)}"
             )
         return entry
 
-    def _make_snapshot(self, version: int, entries: dict[str, LibraryEntry], files: dict[str, Path]) -> LibrarySnapshot:
+    def _make_snapshot(self, version: int, entries: dict[str, LibraryEntry],
+                       files: dict[str, Path]) -> LibrarySnapshot:
         if self.neutral not in entries:
-            raise LibraryError(f"neutral motion '{self.neutral}' is not in the library {[str(p) for p in self.paths]}")
+            raise LibraryError(f"neutral motion '{self.neutral}' is not in the library "
+                               f"{[str(p) for p in self.paths]}")
         defaults: dict[str, str] = {}
         for cls in CLASSES:
             configured = self.class_defaults.get(cls)
@@ -230,7 +181,8 @@ class MotionLibrary:
                     defaults[cls] = members[0]
         unknown = set(self.class_defaults) - set(CLASSES)
         if unknown:
-            raise LibraryError(f"library.class_defaults has unknown classes {sorted(unknown)}; allowed: {CLASSES}")
+            raise LibraryError(f"library.class_defaults has unknown classes {sorted(unknown)}; "
+                               f"allowed: {CLASSES}")
         return LibrarySnapshot(version, entries, files, defaults, self.neutral)
 
     # -- writing (Pose Studio) -----------------------------------------------------------------
@@ -243,7 +195,8 @@ class MotionLibrary:
         target = existing if existing is not None else self.write_dir / f"{entry.name}.yaml"
         if target.resolve().parent not in {p.resolve() for p in self.paths}:
             raise LibraryError(f"refusing to write {target}: outside the library folders")
-        text = yaml.safe_dump(entry.model_dump(mode="json", by_alias=True, exclude_none=True), sort_keys=False)
+        text = yaml.safe_dump(entry.model_dump(mode="json", by_alias=True, exclude_none=True),
+                              sort_keys=False)
         target.parent.mkdir(parents=True, exist_ok=True)
         if target.exists():
             backups = target.parent / ".backup"

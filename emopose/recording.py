@@ -54,14 +54,19 @@ class Recorder:
         """Stream time 0 is clock time `zero` from now on (a stream began, or began again)."""
         with self._lock:
             if zero < self._stream_zero:
-                raise ValueError(f"recorder: a stream cannot restart in the past ({zero} < {self._stream_zero})")
+                raise ValueError(
+                    f"recorder: a stream cannot restart in the past ({zero} < {self._stream_zero})"
+                )
             self._stream_zero = zero
 
     def _channel(self, topic: str) -> int:
         if topic not in self._channels:
-            schema = self._schemas.get(topic, JOINT_STREAM_SCHEMA if topic.startswith("/joints") else GENERIC_SCHEMA)
+            schema = self._schemas.get(
+                topic, JOINT_STREAM_SCHEMA if topic.startswith("/joints") else GENERIC_SCHEMA
+            )
             schema_id = self._writer.register_schema(
-                name=topic.strip("/").replace("/", "."), encoding="jsonschema", data=json.dumps(schema).encode()
+                name=topic.strip("/").replace("/", "."), encoding="jsonschema",
+                data=json.dumps(schema).encode()
             )
             self._channels[topic] = self._writer.register_channel(
                 topic=topic, message_encoding="json", schema_id=schema_id
@@ -84,7 +89,8 @@ class Recorder:
         if self._closed:
             return
         stamp = self.start_ns + int(round(offset_s * 1e9))
-        self._writer.add_message(channel_id=self._channel(topic), log_time=stamp, publish_time=stamp, data=data)
+        self._writer.add_message(channel_id=self._channel(topic), log_time=stamp, publish_time=stamp,
+                                 data=data)
 
     def close(self) -> None:
         with self._lock:
@@ -114,5 +120,6 @@ def read_recording(path: str | Path) -> dict[str, list[tuple[float, dict]]]:
         return {}
     start = min(stamps[0][0] for stamps in by_topic.values())
     return {
-        topic: [((stamp - start) / 1e9, payload) for stamp, payload in rows] for topic, rows in by_topic.items()
+        topic: [((stamp - start) / 1e9, payload) for stamp, payload in rows]
+        for topic, rows in by_topic.items()
     }

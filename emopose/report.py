@@ -38,7 +38,8 @@ class MissingSuite(Exception):
 def run_one(experiment: str, planner: str, run_dir: Path, overrides: list[str]) -> float:
     """Compose +experiment=<experiment> planner=<planner> (+ overrides), run it into run_dir; wall seconds."""
     with initialize_config_dir(config_dir=str(CONFIG_DIR), version_base="1.3"):
-        cfg = compose("config", overrides=[f"+experiment={experiment}", f"planner={planner}", "run.record=false",
+        cfg = compose("config", overrides=[f"+experiment={experiment}", f"planner={planner}",
+                                           "run.record=false",
                                            *overrides])
     suite = Path(OmegaConf.select(cfg, "bench.path"))
     if not suite.is_file():

@@ -27,7 +27,8 @@ LOWER = [-3.0892, -1.5882, -2.618, -1.0472, -1.97222, -1.61443, -1.61443,
 UPPER = [2.6704, 2.2515, 2.618, 2.0944, 1.97222, 1.61443, 1.61443,
          2.6704, 1.5882, 2.618, 2.0944, 1.97222, 1.61443, 1.61443]
 NAMES = [f"{side}_{j}_joint" for side in ("left", "right") for j in
-         ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw")]
+         ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow", "wrist_roll", "wrist_pitch",
+          "wrist_yaw")]
 REST = [0.2, 0.2, 0.0, 0.3, 0.0, 0.0, 0.0, 0.2, -0.2, 0.0, 0.3, 0.0, 0.0, 0.0]
 
 

@@ -25,11 +25,13 @@ DEFAULTS = {group: option for entry in OmegaConf.load(CONFIG_DIR / "config.yaml"
             if isinstance(entry, DictConfig) for group, option in entry.items()}
 UNBUILDABLE = {("planner", "local"): "trains for minutes on first use (tests/planners/test_local.py)",
                ("planner", "annotate"): "its annotator is planner=local (tests/planners/test_annotate.py)"}
-CONSUMED_WITH = {"prompt": ["planner=llm"], "arm_law": ["backend=mujoco"]}  # read by some options of another group
+# read by some options of another group
+CONSUMED_WITH = {"prompt": ["planner=llm"], "arm_law": ["backend=mujoco"]}
 
 
 def built_from(node: DictConfig, obj, *settings: str) -> None:
-    """obj is what node's _target_ makes (a class, or a factory by its return type), and keeps these settings."""
+    """obj is what node's _target_ makes (a class, or a factory by its return type), and keeps these
+    settings."""
     if "_target_" not in node:
         assert obj is None, f"{node} builds nothing, yet the Run holds {obj!r}"
         return
@@ -37,7 +39,8 @@ def built_from(node: DictConfig, obj, *settings: str) -> None:
     made = target if isinstance(target, type) else get_type_hints(target)["return"]
     assert isinstance(obj, made), f"expected a {made.__name__} from {node._target_}, the Run holds {obj!r}"
     for key in (k for k in settings if k in node):
-        assert getattr(obj, key) == node[key], f"{key}: the config says {node[key]!r}, the object {getattr(obj, key)!r}"
+        assert getattr(obj, key) == node[key], (f"{key}: the config says {node[key]!r}, "
+                                                f"the object {getattr(obj, key)!r}")
 
 
 def pipeline_stages(cfg, run) -> None:
@@ -78,7 +81,8 @@ def prompt_read_by_the_planner(cfg, run) -> None:
     assert raw["template"] == "${prompt.template}" and raw["demonstrations"] == "${prompt.demonstrations}"
     planner = run.resources.planner
     assert planner.template.path == Path(cfg.prompt.template).expanduser()
-    assert planner.demonstrations == load_demonstrations(cfg.prompt.demonstrations)[:cfg.prompt.max_demonstrations]
+    assert (planner.demonstrations
+            == load_demonstrations(cfg.prompt.demonstrations)[:cfg.prompt.max_demonstrations])
 
 
 CONSUMERS = {
@@ -116,11 +120,12 @@ def test_the_group_is_built_into_the_run(group, option, tmp_path, monkeypatch):
     assert consumer is not None, (
         f"config group {group!r} is in conf/config.yaml's defaults but nothing says where the build puts it: "
         f"build cfg.{group} in emopose/build.py and add '{group}' to CONSUMERS in {Path(__file__).name}")
-    monkeypatch.setenv("OPENAI_API_KEY", "sk-never-sent")  # hosted planners check for a key; nothing is called
+    # hosted planners check for a key; nothing is called
+    monkeypatch.setenv("OPENAI_API_KEY", "sk-never-sent")
     chosen = {"planner": "keyword", group: option}  # keyword: nothing trains or downloads
     cfg = compose_config([f"{g}={o}" for g, o in chosen.items()] + CONSUMED_WITH.get(group, []))
-    if "probe" in cfg.planner:  # LLM planners probe their endpoint at build; there is no server here
-        cfg.planner.probe = False
+    if "client" in cfg.planner:  # LLM planners probe their endpoint at build; there is no server here
+        cfg.planner.client.probe = False
     with build_run(cfg, tmp_path) as run:
         consumer(cfg, run)
 

@@ -1,4 +1,5 @@
-"""The import graph points down the layers of ../shared/DESIGN.md and has no circle (README: How it fits together).
+"""The import graph points down the layers of ../shared/DESIGN.md and has no circle
+(README: How it fits together).
 
 Every `import` / `from ... import` of an emopose module anywhere in a file counts, including those inside
 functions and under TYPE_CHECKING: a late import is still a dependency.
@@ -17,8 +18,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "emopose"
 # sub-layers matters too: the LLM client and speech sit below the planners, which may use both.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("base", ("emopose", "emopose.config", "emopose.robot", "emopose.clock", "emopose.recording",
-              "emopose.results", "emopose.scene")),
-    ("know: contract", ("emopose.contract", "emopose.library")),
+              "emopose.results", "emopose.sentences", "emopose.scene")),
+    ("know: contract", ("emopose.contract", "emopose.joint_limits", "emopose.library")),
     ("know: llm", ("emopose.llm",)),
     ("know: speech", ("emopose.speech",)),
     ("know: suites", ("emopose.bench",)),
@@ -37,25 +38,30 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+def is_module(dotted: str) -> bool:
+    path = PACKAGE.parent / dotted.replace(".", "/")
+    return path.with_suffix(".py").is_file() or path.is_dir()
+
+
 def imported_modules(path: Path) -> set[str]:
     """The emopose modules a file imports (`from a.b import c` counts as a.b.c when that is a module)."""
     found = set()
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.Import):
             found |= {alias.name for alias in node.names if alias.name.startswith("emopose")}
-        elif isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith("emopose"):
+        elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("emopose"):
             found.add(node.module)
-            found |= {f"{node.module}.{alias.name}" for alias in node.names
-                      if (PACKAGE.parent / f"{node.module}.{alias.name}".replace(".", "/")).with_suffix(".py").is_file()
-                      or (PACKAGE.parent / f"{node.module}.{alias.name}".replace(".", "/")).is_dir()}
+            found |= {f"{node.module}.{a.name}" for a in node.names if is_module(f"{node.module}.{a.name}")}
     return found
 
 
 def layer_of(module: str) -> int:
+    """The layer of the longest matching prefix; the package itself (constants) matches only exactly."""
     best, index = "", None
     for i, (_, prefixes) in enumerate(LAYERS):
         for prefix in prefixes:
-            if (module == prefix or module.startswith(prefix + ".")) and len(prefix) > len(best):
+            inside = module == prefix or (prefix != "emopose" and module.startswith(prefix + "."))
+            if inside and len(prefix) > len(best):
                 best, index = prefix, i
     if index is None:
         raise AssertionError(f"{module} belongs to no layer: add it to LAYERS in {Path(__file__).name}")

@@ -40,7 +40,8 @@ def dialogue_texts(path: Path, prefix: str, lines: bool = True) -> list[Text]:
     """Each dialogue as one text (its history, then its final utterance); with `lines`, also each line of
     4+ words on its own (a shorter fragment, "That one.", is too generic to leak: its context decides)."""
     out = []
-    for k, row in enumerate(json.loads(line) for line in path.read_text(encoding="utf-8").splitlines() if line):
+    for k, row in enumerate(json.loads(line)
+                            for line in path.read_text(encoding="utf-8").splitlines() if line):
         said = [turn["content"] for turn in row["history"]] + [row["text"]]
         key = f"{prefix}:{row.get('id', k)}"
         out.append(Text.of(f"{key}:dialogue", " ".join(said)))
@@ -51,7 +52,8 @@ def dialogue_texts(path: Path, prefix: str, lines: bool = True) -> list[Text]:
 
 def training_dialogues(lines: bool = True) -> list[Text]:
     files = sorted(CONTEXT_TRAIN_DIR.glob("*.jsonl"))
-    assert files, "experiments/train/context/*.jsonl is missing: the context training split ships with the repository"
+    assert files, ("experiments/train/context/*.jsonl is missing: "
+                   "the context training split ships with the repository")
     return [t for f in files for t in dialogue_texts(f, f"train/context/{f.stem}", lines)]
 
 
@@ -123,7 +125,8 @@ def test_no_suite_item_paraphrases_a_training_item_or_demonstration(suite, sente
     others = training_texts() + texts_of(shipped(DEMONSTRATIONS), "demo")
     similarity = sentence_encoder(texts) @ sentence_encoder(others).T
     rows, cols = (similarity >= PARAPHRASE_COSINE).nonzero()
-    pairs = [f"{texts[i].key} ~ {others[j].key} (cosine {similarity[i, j]:.3f}): {texts[i].raw!r} / {others[j].raw!r}"
+    pairs = [f"{texts[i].key} ~ {others[j].key} (cosine {similarity[i, j]:.3f}): "
+             f"{texts[i].raw!r} / {others[j].raw!r}"
              for i, j in zip(rows, cols)]
     if pairs:
         pytest.fail(f"{len(pairs)} paraphrase pair(s):\n" + "\n".join(pairs[:SHOWN]), pytrace=False)

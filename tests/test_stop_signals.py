@@ -38,7 +38,8 @@ def read_every_message(path) -> list[tuple[str, dict]]:
     from mcap.reader import make_reader
 
     with open(path, "rb") as f:
-        return [(channel.topic, json.loads(message.data)) for _, channel, message in make_reader(f).iter_messages()]
+        return [(channel.topic, json.loads(message.data))
+                for _, channel, message in make_reader(f).iter_messages()]
 
 
 def test_sigterm_releases_the_robot_closes_the_recording_and_writes_results(tmp_path):

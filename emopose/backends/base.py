@@ -31,12 +31,18 @@ class Backend(ABC):
         backend cannot measure (the run then starts from the library's neutral pose)."""
 
     @abstractmethod
-    def send(self, t: float, q: np.ndarray) -> None:
-        """Command the (14,) target q at stream time t (seconds since the stream started)."""
+    def send(self, t: float, q: np.ndarray) -> np.ndarray:
+        """Command the (14,) target q at stream time t (seconds since the stream started); return what
+        was actually sent (q clamped to the backend's limits), the command the loop records."""
 
     @abstractmethod
     def measured(self) -> np.ndarray | None:
         """The latest measured (14,) joint positions, or None if the backend cannot measure."""
+
+    @property
+    @abstractmethod
+    def is_connected(self) -> bool:
+        """Between a successful connect() and close() (or a fault): send() is accepted."""
 
     @abstractmethod
     def close(self) -> None:

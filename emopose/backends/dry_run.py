@@ -15,18 +15,26 @@ class DryRunBackend(Backend):
         self.initial_pose = None if initial_pose is None else np.asarray(initial_pose, dtype=float)
         self.sent = 0
         self._last: np.ndarray | None = None
+        self._connected = False
 
     def connect(self, recorder: Recorder | None) -> np.ndarray | None:
         """No measurement: the run starts from initial_pose, or from the library's neutral pose if None."""
         self._last = self.initial_pose
+        self._connected = True
         return self.initial_pose
 
-    def send(self, t: float, q: np.ndarray) -> None:
+    def send(self, t: float, q: np.ndarray) -> np.ndarray:
+        """No limits to clamp to: q goes out as it is."""
         self._last = q
         self.sent += 1
+        return q
 
     def measured(self) -> np.ndarray | None:
         return self._last
 
+    @property
+    def is_connected(self) -> bool:
+        return self._connected
+
     def close(self) -> None:
-        pass
+        self._connected = False

@@ -79,6 +79,7 @@ class MujocoBackend(Backend):
         self._lock = threading.RLock()
         self._viewer = None
         self._tick = 0
+        self._connected = False
 
     def select_gl(self) -> bool:
         """mujoco reads MUJOCO_GL at its first import: glfw for the viewer window, else egl."""
@@ -111,7 +112,8 @@ class MujocoBackend(Backend):
         self._act = np.array([m.actuator(n).id for n in JOINT_NAMES])
         self._lo, self._hi = m.jnt_range[[j.id for j in joints]].T
         self._tau_limit = m.jnt_actfrcrange[[j.id for j in joints], 1]
-        self._mjcf_servos = (m.actuator_gainprm[self._act, 0].copy(), -m.actuator_biasprm[self._act, 2].copy())
+        self._mjcf_servos = (m.actuator_gainprm[self._act, 0].copy(),
+                             -m.actuator_biasprm[self._act, 2].copy())
         self._mjcf_gravcomp = (m.body_gravcomp.copy(), m.jnt_actgravcomp.copy())
         self._gravity: GravityModel | None = None  # built the first time a law asks for a gravity torque
         self.apply_law(self.law)
@@ -129,9 +131,11 @@ class MujocoBackend(Backend):
             import mujoco.viewer
 
             self._viewer = mujoco.viewer.launch_passive(m, self.data)
+        self._connected = True
         return self.measured()
 
-    def send(self, t: float, q: np.ndarray) -> None:
+    def send(self, t: float, q: np.ndarray) -> np.ndarray:
+        """One control period of physics toward q clipped to the joints' ranges; returns that target."""
         if self.data is None:
             raise RuntimeError("mujoco backend: send() before connect()")
         target = np.clip(np.asarray(q, dtype=float).reshape(NUM_JOINTS), self._lo, self._hi)
@@ -158,6 +162,7 @@ class MujocoBackend(Backend):
         self.renderer.after_tick(self._tick)
         if self._viewer is not None and self._viewer.is_running():
             self._viewer.sync()
+        return target
 
     def apply_law(self, law: ArmLaw) -> None:
         """Servo gains and feed-forwards of `law`. Without gains it keeps the MJCF's own servos, whose
@@ -202,7 +207,12 @@ class MujocoBackend(Backend):
         with self._lock:
             return self.data.qpos[self._qadr].copy()
 
+    @property
+    def is_connected(self) -> bool:
+        return self._connected
+
     def close(self) -> None:
+        self._connected = False
         self.renderer.close()
         if self._viewer is not None:
             self._viewer.close()

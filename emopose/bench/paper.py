@@ -13,10 +13,14 @@ PAPER_SEMANTIC: dict[str, dict[str, tuple[float, float | None]]] = {
                      "overall": (72.08, 0.74)},
     "sbert_centroids": {"easy": (97.50, None), "medium": (58.75, None), "hard": (52.50, None),
                         "overall": (69.58, None)},
-    "keyword": {"easy": (62.50, None), "medium": (16.88, None), "hard": (11.25, None), "overall": (30.21, None)},
-    "tfidf": {"easy": (26.88, None), "medium": (22.50, None), "hard": (23.13, None), "overall": (24.17, None)},
-    "jaccard": {"easy": (21.25, None), "medium": (17.50, None), "hard": (18.13, None), "overall": (18.96, None)},
-    "chance": {"easy": (12.50, None), "medium": (12.50, None), "hard": (12.50, None), "overall": (12.50, None)},
+    "keyword": {"easy": (62.50, None), "medium": (16.88, None), "hard": (11.25, None),
+                "overall": (30.21, None)},
+    "tfidf": {"easy": (26.88, None), "medium": (22.50, None), "hard": (23.13, None),
+              "overall": (24.17, None)},
+    "jaccard": {"easy": (21.25, None), "medium": (17.50, None), "hard": (18.13, None),
+                "overall": (18.96, None)},
+    "chance": {"easy": (12.50, None), "medium": (12.50, None), "hard": (12.50, None),
+               "overall": (12.50, None)},
 }
 
 PAPER_METHOD_NAMES = {
@@ -26,7 +30,8 @@ PAPER_METHOD_NAMES = {
 }
 
 # Table extensions: the full planner (GPT-5.5, structured prompt), five passes.
-PAPER_CONTEXT = {"llm": {"with_history": (96.69, 0.36), "without_history": (95.00, 1.06), "gain": (1.69, 0.98)}}
+PAPER_CONTEXT = {"llm": {"with_history": (96.69, 0.36), "without_history": (95.00, 1.06),
+                         "gain": (1.69, 0.98)}}
 PAPER_SEQUENCE = {
     "llm": {
         "primary_class": (97.75, 0.68), "ordered_exact": (91.50, 0.71), "aligned_step": (95.49, 0.31),

@@ -2,8 +2,9 @@
 
 Three formats (see experiments/README and the spec): the single-label benchmark
 {"id", "text", "label", "tier"}, the context suite {"id", "history", "text", "label"} and the sequence
-suite {"id", "text", "labels", "anchors", "variants"}. A malformed file is refused with a SuiteError
-that names the file, the line and the field, and says what is allowed. Blank lines are skipped.
+suite {"id", "text", "labels", "anchors", "variants"} (planned by sequence_suite, and measured as
+annotated plans by sync_eval). A malformed file is refused with a SuiteError that names the file, the
+line and the field, and says what is allowed. Blank lines are skipped.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from emopose import CLASSES
+from emopose.contract import GestureRecord, Plan
 
 TIERS: tuple[str, ...] = ("easy", "medium", "hard")
 ROLES = ("user", "assistant")
@@ -57,6 +59,12 @@ class SequenceItem:
         """Character spans of the anchors, found left to right (each after the previous one's end)."""
         return anchor_spans(self.text, self.anchors)
 
+    def plan(self) -> Plan:
+        """The annotation as the planner's answer: the reply is the text, one record per label."""
+        records = tuple(GestureRecord(cls=c, variant=v, trigger=a) for c, a, v in
+                        zip(self.labels, self.anchors, self.variants))
+        return Plan(reply=self.text, records=records, source="scripted", notes=("sync_eval annotation",))
+
 
 def anchor_spans(text: str, anchors: tuple[str, ...] | list[str]) -> list[tuple[int, int]]:
     spans, start = [], 0
@@ -79,7 +87,8 @@ def _records(path: Path) -> Iterator[tuple[int, dict]]:
             try:
                 obj = json.loads(line)
             except json.JSONDecodeError as exc:
-                raise SuiteError(path, line_no, None, f"not valid JSON ({exc.msg}, column {exc.colno})") from exc
+                problem = f"not valid JSON ({exc.msg}, column {exc.colno})"
+                raise SuiteError(path, line_no, None, problem) from exc
             if not isinstance(obj, dict):
                 raise SuiteError(path, line_no, None, f"expected a JSON object, got {type(obj).__name__}")
             yield line_no, obj
@@ -151,8 +160,11 @@ def load_context(path: str | Path) -> list[ContextItem]:
     return items
 
 
-def load_sequence(path: str | Path, variant_classes: Mapping[str, str] | None = None) -> list[SequenceItem]:
-    """Sequence items; with `variant_classes` (motion name -> class) variants are checked against it."""
+def load_sequence(path: str | Path, variant_classes: Mapping[str, str] | None = None,
+                  anchors_in_text: bool = True) -> list[SequenceItem]:
+    """Sequence items; with `variant_classes` (motion name -> class) variants are checked against it.
+    `anchors_in_text=False` accepts an anchor that is not in the text (sync_eval's say-do check
+    measures such items and reports the missing trigger)."""
     path, seen, items = Path(path), set(), []
     for line, obj in _records(path):
         c = _Checker(path, line, obj, seen)
@@ -163,10 +175,11 @@ def load_sequence(path: str | Path, variant_classes: Mapping[str, str] | None = 
         if not len(labels) == len(anchors) == len(variants):
             c.fail("anchors", f"labels, anchors and variants must have equal lengths, got "
                               f"{len(labels)}, {len(anchors)}, {len(variants)}")
-        try:
-            anchor_spans(text, anchors)
-        except ValueError as exc:
-            c.fail("anchors", f"{exc}; anchors must be exact substrings of text, in label order")
+        if anchors_in_text:
+            try:
+                anchor_spans(text, anchors)
+            except ValueError as exc:
+                c.fail("anchors", f"{exc}; anchors must be exact substrings of text, in label order")
         if variant_classes is not None:
             for k, (variant, label) in enumerate(zip(variants, labels)):
                 if variant not in variant_classes:

@@ -70,7 +70,8 @@ def write_sweep_table(root: str | Path, title: str = "Sweep results") -> Path | 
         log.info("no benchmark results.json under %s; no sweep table written", root)
         return None
     (root / "sweep_results.json").write_text(json.dumps(summaries, indent=2, default=float) + "\n")
-    note = "Cells: ours (paper), mean±SD over passes where passes > 1. Per-job details: each job_dir's results.md."
+    note = ("Cells: ours (paper), mean±SD over passes where passes > 1. "
+            "Per-job details: each job_dir's results.md.")
     md = root / "sweep_results.md"
     md.write_text(f"# {title}\n\n{root}\n\n" + comparison_markdown(summaries, note))
     return md

@@ -57,7 +57,8 @@ def bench_table(results: Sequence[dict]) -> str:
     for r in results:
         paper = PAPER_SEMANTIC.get(r["method"], {})
         acc = r["accuracy"]
-        rows.append([row_label(r), r["n"], r["passes"], *[beside(acc.get(t), paper.get(t)) for t in TIER_KEYS],
+        rows.append([row_label(r), r["n"], r["passes"],
+                     *[beside(acc.get(t), paper.get(t)) for t in TIER_KEYS],
                      r.get("fallbacks", 0), r.get("failures", 0), _ms(r)])
     ran = {r["method"] for r in results}
     rows += [row + ["", "", ""] for row in _paper_only(PAPER_SEMANTIC, ran, TIER_KEYS)]
@@ -75,7 +76,8 @@ def context_table(results: Sequence[dict]) -> str:
                      r.get("failures", 0)])
     ran = {r["method"] for r in results}
     rows += [row + [""] for row in _paper_only(PAPER_CONTEXT, ran, CONTEXT_KEYS)]
-    return markdown_table(["method", "n", "passes", "with history", "without history", "gain", "failures"], rows)
+    return markdown_table(["method", "n", "passes", "with history", "without history", "gain", "failures"],
+                          rows)
 
 
 def sequence_table(results: Sequence[dict]) -> str:
@@ -83,7 +85,8 @@ def sequence_table(results: Sequence[dict]) -> str:
     for r in results:
         paper = PAPER_SEQUENCE.get(r["method"], {})
         m = r["metrics"]
-        rows.append([row_label(r), r["n"], r["passes"], *[beside(m.get(k), paper.get(k)) for k in SEQUENCE_KEYS],
+        rows.append([row_label(r), r["n"], r["passes"],
+                     *[beside(m.get(k), paper.get(k)) for k in SEQUENCE_KEYS],
                      f"{r['segmentation']['over_total']}/{r['segmentation']['under_total']}"])
     ran = {r["method"] for r in results}
     paper_rows = _paper_only(PAPER_SEQUENCE, ran, SEQUENCE_KEYS)

@@ -1,5 +1,6 @@
 """The 50 Hz loop: ticks the sequencer on absolute deadlines and hands each target to the backend.
 
+The loop records, on /joints/command, what the backend says it sent (the target after its clamping).
 Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt) chains). Deadlines
 that passed a whole period ago, or before the previous command went out, are skipped, not sent in a
 burst: after a stall (or while nobody drove the loop, e.g. the planner was thinking) the loop
@@ -26,6 +27,7 @@ from emopose import CONTROL_DT
 from emopose.backends.base import Backend
 from emopose.clock import Clock
 from emopose.execution.sequencer import Sequencer
+from emopose.execution.worker import Worker
 from emopose.recording import Recorder
 
 log = logging.getLogger(__name__)
@@ -56,7 +58,8 @@ class LoopStats:
         late = np.asarray(self.lateness_s or [0.0]) * 1e3
         return {"ticks": self.ticks, "missed_deadlines": self.missed_deadlines, "stalls": self.stalls,
                 "idle_ticks": self.idle_ticks, "lateness_ms_p50": float(np.percentile(late, 50)),
-                "lateness_ms_p99": float(np.percentile(late, 99)), "lateness_ms_max": self.lateness_max_s * 1e3}
+                "lateness_ms_p99": float(np.percentile(late, 99)),
+                "lateness_ms_max": self.lateness_max_s * 1e3}
 
 
 class ControlLoop:
@@ -68,8 +71,7 @@ class ControlLoop:
         self._tick = 0
         self._last_sent = -np.inf  # clock time the previous command went out
         self._resuming = True  # nobody drove the loop since the last tick: lag is idle time, not a stall
-        self._thread: threading.Thread | None = None
-        self._stop = threading.Event()
+        self._worker = Worker("emopose-control", self._run, join_timeout_s=2.0)
         self.error: BaseException | None = None
 
     def begin(self, q0: np.ndarray, recorder: Recorder | None = None) -> None:
@@ -93,6 +95,7 @@ class ControlLoop:
         return clock_time - (self._t0 or 0.0)
 
     def tick(self) -> np.ndarray:
+        """Wait for the next deadline, send the sequencer's target; returns (and records) what was sent."""
         deadline = self._t0 + (self._tick + 1) * self.dt
         # Deadlines a whole period past, or at or before the previous send (it stood for them), are
         # skipped: the loop re-anchors on the grid instead of bursting the backlog out.
@@ -110,13 +113,12 @@ class ControlLoop:
         self.clock.sleep_until(max(deadline, self._last_sent + self.dt / 2))
         self.stats.add(self.clock.now() - deadline)
         self._tick += 1
-        q = self.sequencer.step(deadline)
         t = deadline - self._t0
-        self.backend.send(t, q)
+        sent = self.backend.send(t, self.sequencer.step(deadline))
         self._last_sent = self.clock.now()
         if self.recorder is not None:
-            self.recorder.write("/joints/command", t, {"t": t, "q": q.tolist()})
-        return q
+            self.recorder.write("/joints/command", t, {"t": t, "q": sent.tolist()})
+        return sent
 
     def run_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
         """Tick until done() (checked after each tick) or timeout (stream seconds). True if done.
@@ -144,26 +146,19 @@ class ControlLoop:
 
     # -- background thread ---------------------------------------------------------------------
     def start(self) -> None:
-        if self._thread is not None:
-            return
-        self._stop.clear()
-        self._thread = threading.Thread(target=self._run, name="emopose-control", daemon=True)
-        self._thread.start()
+        self._worker.start()
 
-    def _run(self) -> None:
+    def _run(self, stop: threading.Event) -> None:
         try:
-            while not self._stop.is_set():
+            while not stop.is_set():
                 self.tick()
         except BaseException as exc:  # surfaced to the owner; the backend's close() does the safe release
             self.error = exc
             log.exception("control loop stopped")
 
     def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout=2.0)
-            self._thread = None
+        self._worker.stop()
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        return self._worker.running

@@ -1,4 +1,4 @@
-"""What the sequencer is handed (a GestureCommand) and what it reports (an Event).
+"""What the sequencer is handed (a GestureCommand) and what it reports (an Event, its State).
 
 A command is a motion to run: intensity-modulated keyframes, a duration and an earliest start on the
 control clock (the paper's FIFO-with-release behaviour); a timed command (the timeline) also fixes
@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field
+from enum import StrEnum
 
 import numpy as np
+
+from emopose.contract import EventKind
 
 
 @dataclass(frozen=True)
@@ -28,17 +31,26 @@ class GestureCommand:
     stroke: tuple[int, int] | None = None   # keyframe indices of the stroke, for the "stroke" event
     offsets: tuple[float, ...] | None = None
     blend_in: bool = False                  # timed: the first segment is a co-articulation blend
-    cut: bool = False                       # timed: planned to end after its stroke (reported as "cut")
+    cut: bool = False                       # timed: planned to end after its stroke (reported as CUT)
 
     @property
     def timed(self) -> bool:
         return self.offsets is not None
 
 
+class State(StrEnum):
+    """The sequencer's state (its docstring draws the transitions)."""
+
+    IDLE = "idle"
+    EXECUTING = "executing"
+    HOLDING = "holding"
+    BLENDING = "blending"
+
+
 @dataclass(frozen=True)
 class Event:
     t: float
-    kind: str  # started, stroke, completed, cut, stopped, rejected, dropped, state
+    kind: EventKind
     name: str = ""
     command_id: int | None = None
     detail: str = ""

@@ -7,19 +7,17 @@ EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> 
 any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
 Beyond the paper (off by default): with `preempt_after_s` set, a queued command whose release time has
 passed by that much cuts the running motion short with a normal blend, so long motions do not push
-later gestures away from their words; a negative value (-blend_s) starts that blend early so the
-successor begins on its word.
+later gestures away from their words (-blend_s: the successor begins on its word).
 
-`step(now)` is called once per 50 Hz tick and returns the 14-DoF target to publish; every transition
-starts from the latest published pose, so the stream never jumps. submit/interrupt are thread-safe.
-Time is whatever `now` the caller passes: tests drive it with a fake clock.
+`step(now)`, once per 50 Hz tick, returns the 14-DoF target to publish; every transition starts from the
+latest published pose, so the stream never jumps. submit/interrupt are thread-safe. Time is the `now`
+the caller passes (tests drive it with a fake clock).
 
-Timed commands (the stroke-synchronous timeline, emopose/turn/timeline.py) carry every keyframe's time: one
-starts at its release time from the pose published then (no blend in front: its first segment is its
-own transition), preempting ("cut") a motion still running, and its trajectory meets the keyframe
-times, lengthening only what the speed bound forbids. Events: started, stroke (the arm within
-STROKE_TOLERANCE of the stroke-start keyframe), completed, cut (ended after its stroke, co-articulated or preempted), stopped,
-rejected, dropped (by the timeline, with its reason), state.
+Timed commands (the stroke-synchronous timeline, emopose/turn/timeline.py) carry every keyframe's time:
+one starts at its release time from the pose published then (no blend in front: its first segment is its
+own transition), preempting (CUT) a motion still running, and its trajectory meets the keyframe
+times, lengthening only what the speed bound forbids. Events: EventKind (gesture_command.py); STROKE
+is the arm within STROKE_TOLERANCE of the stroke-start keyframe.
 """
 
 from __future__ import annotations
@@ -29,22 +27,13 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import replace
-from enum import StrEnum
 
 import numpy as np
 
+from emopose.contract import EventKind
 from emopose.execution.bounded_log import BoundedLog
-from emopose.execution.gesture_command import Event, GestureCommand
+from emopose.execution.gesture_command import Event, GestureCommand, State
 from emopose.execution.trajectory import Trajectory, TrajectoryBuilder
-from emopose.sync.strokes import first_within
-
-
-class State(StrEnum):
-    IDLE = "idle"
-    EXECUTING = "executing"
-    HOLDING = "holding"
-    BLENDING = "blending"
-
 
 SafetyCheck = Callable[[np.ndarray], "str | None"]
 
@@ -98,7 +87,7 @@ class Sequencer:
     def drop(self, command: GestureCommand, reason: str, now: float) -> None:
         """Record a gesture the timeline could not fit (it is never queued)."""
         with self._lock:
-            self._emit(now, "dropped", command, reason)
+            self._emit(now, EventKind.DROPPED, command, reason)
 
     def interrupt(self, commands: list[GestureCommand] | tuple = (), now: float | None = None) -> None:
         """Clear pending actions; blend from the latest published pose to the first new command (or neutral).
@@ -107,7 +96,7 @@ class Sequencer:
         with self._lock:
             now = self._hold_since if now is None else now
             if self._active is not None:
-                self._emit(now, "stopped", self._active)
+                self._emit(now, EventKind.STOPPED, self._active)
             self._queue.clear()
             timed = bool(commands) and commands[0].timed
             self._queue.extend(commands if timed else commands[1:])
@@ -148,11 +137,11 @@ class Sequencer:
             if self.state in (State.EXECUTING, State.BLENDING):
                 self._advance(now)
             if self.state == State.EXECUTING and self._timed_head_due(now):
-                self._emit(now, "cut", self._active, "preempted at the next gesture's timeline start")
+                self._emit(now, EventKind.CUT, self._active, "preempted at the next gesture's timeline start")
                 self._active = None
                 self._begin_or_hold(self._queue.popleft(), now)
             if self.state == State.EXECUTING and self._overdue(now):
-                self._emit(now, "stopped", self._active, "preempted by an overdue successor")
+                self._emit(now, EventKind.STOPPED, self._active, "preempted by an overdue successor")
                 head = self._queue.popleft()
                 self._start_blend(now, np.asarray(head.keyframes[0]), self.blend_s, head)
             if self.state in (State.IDLE, State.HOLDING) or self._recovering():
@@ -166,12 +155,15 @@ class Sequencer:
         self._index += 1
         self.last = self._motion.samples[self._index].copy()
         if self._index == self._stroke_tick and self.state == State.EXECUTING:
-            self._emit(now, "stroke", self._active)
+            self._emit(now, EventKind.STROKE, self._active)
         if self._index < len(self._motion.samples) - 1:
             return
         if self.state == State.EXECUTING:
             done = self._active
-            self._emit(now, *(("cut", done, "co-articulated into the next gesture") if done.cut else ("completed", done)))
+            if done.cut:
+                self._emit(now, EventKind.CUT, done, "co-articulated into the next gesture")
+            else:
+                self._emit(now, EventKind.COMPLETED, done)
             self._active = None
             head = self._queue[0] if self._queue else None
             if head is not None and head.release_at <= now:
@@ -213,32 +205,23 @@ class Sequencer:
         self.construction_s.append(time.perf_counter() - started)
         reason = self.safety(motion.samples) if self.safety else None
         if reason is not None:
-            self._emit(now, "rejected", command, reason)
+            self._emit(now, EventKind.REJECTED, command, reason)
             return False
         self._motion, self._index, self._active = motion, 0, command
-        self._stroke_tick = self._arrival_tick(motion, command)
+        stroke = command.stroke
+        self._stroke_tick = -1 if stroke is None else motion.arrival_tick(command.keyframes, stroke[0])
         self._set_state(now, State.EXECUTING)
         detail = (f"late={motion.late_s * 1e3:.0f}ms" if motion.late_s > 0.01
                   else f"stretch={motion.stretch:.2f}" if motion.stretch > 1 else "")
-        self._emit(now, "started", command, detail)
+        self._emit(now, EventKind.STARTED, command, detail)
         return True
-
-    @staticmethod
-    def _arrival_tick(motion: Trajectory, command: GestureCommand) -> int:
-        """The sample at which the stroke arrives (within STROKE_TOLERANCE of its start keyframe, on
-        the way there), or -1 without a declared stroke."""
-        if command.stroke is None:
-            return -1
-        start = command.stroke[0]
-        reached = motion.anchor_ticks[max(start, 1)]
-        hit = first_within(motion.samples[1:reached + 1], np.asarray(command.keyframes)[start])
-        return reached if hit is None else 1 + hit
 
     def _begin_or_hold(self, command: GestureCommand, now: float) -> None:
         if not self._begin(command, now):
             self._set_state(now, State.HOLDING)
 
-    def _start_blend(self, now: float, target: np.ndarray, duration: float, then: GestureCommand | None) -> None:
+    def _start_blend(self, now: float, target: np.ndarray, duration: float,
+                     then: GestureCommand | None) -> None:
         self._motion = self.builder.blend(self.last, target, duration)
         self._index, self._active, self._after_blend = 0, None, then
         self._set_state(now, State.BLENDING)
@@ -254,9 +237,9 @@ class Sequencer:
             self._hold_since = now
         if state != self.state:
             self.state = state
-            self._emit(now, "state", None, state.value)
+            self._emit(now, EventKind.STATE, None, state.value)
 
-    def _emit(self, now: float, kind: str, command: GestureCommand | None, detail: str = "") -> None:
+    def _emit(self, now: float, kind: EventKind, command: GestureCommand | None, detail: str = "") -> None:
         event = Event(now, kind, command.name if command else "", command.id if command else None, detail)
         self.events.append(event)
         if self.on_event is not None:

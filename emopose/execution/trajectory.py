@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from emopose import CONTROL_DT
-from emopose.library import JointLimits
+from emopose.joint_limits import JointLimits
+from emopose.sync.strokes import first_within
 
 SMOOTHSTEP_INCREMENTS = 5
 
@@ -50,6 +51,13 @@ class Trajectory:
     @property
     def duration(self) -> float:
         return (len(self.samples) - 1) * self.dt
+
+    def arrival_tick(self, keyframes: np.ndarray, key: int) -> int:
+        """The sample at which the arm comes within STROKE_TOLERANCE of keyframes[key] on its way there
+        (the stroke's arrival), at the latest the sample that reaches it."""
+        reached = self.anchor_ticks[max(key, 1)]
+        hit = first_within(self.samples[1:reached + 1], np.asarray(keyframes)[key])
+        return reached if hit is None else 1 + hit
 
 
 class TrajectoryBuilder:
@@ -112,7 +120,8 @@ class TrajectoryBuilder:
 
     def segment_minimum(self, q_from: np.ndarray, q_to: np.ndarray, blend: bool = False) -> float:
         """Shortest duration (s) of one eased segment that keeps every joint within its speed bound."""
-        peak = 3.0 if blend else self._steepest * self.increments  # beta' peaks at 3; smoothstep waypoints ~1.48
+        # beta' peaks at 3, the smoothstep waypoints' slope at ~1.48
+        peak = 3.0 if blend else self._steepest * self.increments
         return peak * float(np.max(np.abs(np.asarray(q_to) - np.asarray(q_from)) * self._inv_velocity))
 
     def build_timed(self, keyframes: np.ndarray, times: np.ndarray, q_last: np.ndarray,

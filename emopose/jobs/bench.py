@@ -17,14 +17,14 @@ from emopose.bench.suites import TIERS, load_bench
 from emopose.bench.tables import comparison_markdown, fmt
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
-    check_fallback_share,
     plan_suite,
     resolve_passes,
     run_summary,
+    suite_output,
 )
 from emopose.planners.base import PlanRequest
 from emopose.resources import Resources, Run
-from emopose.results import write_results
+from emopose.results import JobOutput
 
 
 @dataclass
@@ -37,7 +37,7 @@ class BenchJob:
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
     confusion: bool = True
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         unknown = sorted(set(self.tiers) - set(TIERS))
         if unknown:
@@ -54,8 +54,8 @@ class BenchJob:
                                  self.chunk_size, self.progress)
             planned_all.extend(planned)
             for item, outcome in zip(items, planned):
-                row = {"id": item.id, "label": item.label, "pred": outcome.top_class, "tier": item.tier, "pass": p,
-                       "source": outcome.source}
+                row = {"id": item.id, "label": item.label, "pred": outcome.top_class, "tier": item.tier,
+                       "pass": p, "source": outcome.source}
                 if outcome.error is not None:
                     row["error"] = outcome.error
                 predictions.append(row)
@@ -76,16 +76,15 @@ class BenchJob:
         if self.confusion:
             results["confusion_png"] = str(self.write_confusion(res, predictions, results))
             markdown += f"\nConfusion matrices: {results['confusion_png']}\n"
-        write_results(res.run_dir, results, markdown)
-        print(markdown)
-        check_fallback_share(results)
-        return results
+        return suite_output(results, markdown)
 
     def write_confusion(self, res: Resources, predictions: list[dict], results: dict):
         panels = []
         for tier in [t for t in TIERS if t in self.tiers]:
-            counts, failed = confusion_counts([(p["label"], p["pred"]) for p in predictions if p["tier"] == tier])
-            title = f"{tier.capitalize()} ({counts.sum() + failed} decisions): {fmt(results['accuracy'][tier])}%"
+            pairs = [(p["label"], p["pred"]) for p in predictions if p["tier"] == tier]
+            counts, failed = confusion_counts(pairs)
+            title = (f"{tier.capitalize()} ({counts.sum() + failed} decisions): "
+                     f"{fmt(results['accuracy'][tier])}%")
             panels.append(ConfusionPanel(title, counts, failed))
         name = f"{results['method']}, {results['passes']} pass(es), pooled counts"
         return plot_confusion(panels, res.run_dir / "confusion.png", suptitle=name)

@@ -64,7 +64,8 @@ def _pyplot():
     return plt
 
 
-def write_sheet(folder: Path, entry, frames: list[list[np.ndarray]], extra: tuple | None, status: str) -> Path:
+def write_sheet(folder: Path, entry, frames: list[list[np.ndarray]], extra: tuple | None,
+                status: str) -> Path:
     """One PNG: rows = cameras, columns = keyframes (+ the contact pose), titled with name and status."""
     plt = _pyplot()
     columns = list(frames) + ([extra[0]] if extra else [])
@@ -85,7 +86,8 @@ def write_sheet(folder: Path, entry, frames: list[list[np.ndarray]], extra: tupl
                 ax.set_title(label, fontsize=7, color="red" if is_extra else "black")
     color = "black" if status == "ok" else "red"
     title = textwrap.fill(f"{entry.name} ({entry.cls}) - {entry.description}", width=24 * len(columns))
-    fig.suptitle(f"{title}\nlevel 3 keyframes, d={entry.default_duration:.2f}s | {status}", fontsize=8, color=color)
+    fig.suptitle(f"{title}\nlevel 3 keyframes, d={entry.default_duration:.2f}s | {status}", fontsize=8,
+                 color=color)
     fig.tight_layout()
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{entry.name}.png"
@@ -101,7 +103,8 @@ def _keyframe_times(count: int, duration: float) -> list[float]:
     return [round(k * duration / (count - 1) / CONTROL_DT) * CONTROL_DT for k in range(count)]
 
 
-def write_overview(path: Path, library, frames: dict[str, list[list[np.ndarray]]], status: dict[str, str]) -> Path:
+def write_overview(path: Path, library, frames: dict[str, list[list[np.ndarray]]],
+                   status: dict[str, str]) -> Path:
     """Every motion's peak keyframe (first camera) in one grid, ordered by class; red title = contacts."""
     plt = _pyplot()
     from emopose import CLASSES

@@ -15,14 +15,14 @@ from emopose.bench.suites import load_context
 from emopose.bench.tables import comparison_markdown
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
-    check_fallback_share,
     plan_suite,
     resolve_passes,
     run_summary,
+    suite_output,
 )
 from emopose.planners.base import PlanRequest
 from emopose.resources import Run
-from emopose.results import write_results
+from emopose.results import JobOutput
 
 
 @dataclass
@@ -33,7 +33,7 @@ class ContextAblationJob:
     progress: bool = True
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         items = load_context(self.path)
         if not items:
@@ -45,14 +45,15 @@ class ContextAblationJob:
         started = time.perf_counter()
         for p in range(passes):
             tag = f"{planner.name} context pass {p + 1}/{passes}"
-            planned_with = plan_suite(planner, with_history, f"{tag} with history", self.chunk_size, self.progress)
+            planned_with = plan_suite(planner, with_history, f"{tag} with history", self.chunk_size,
+                                      self.progress)
             planned_without = plan_suite(planner, without_history, f"{tag} without", self.chunk_size,
                                          self.progress)
             planned_all += planned_with + planned_without
             for item, a, b in zip(items, planned_with, planned_without):
                 predictions.append({"id": item.id, "label": item.label, "pred_with": a.top_class,
-                                    "pred_without": b.top_class, "history_turns": len(item.history), "pass": p,
-                                    "source_with": a.source, "source_without": b.source})
+                                    "pred_without": b.top_class, "history_turns": len(item.history),
+                                    "pass": p, "source_with": a.source, "source_without": b.source})
         paired = paired_context_accuracy(predictions)
         results = {
             "kind": "context_ablation",
@@ -70,7 +71,4 @@ class ContextAblationJob:
         markdown = comparison_markdown([results]) + (
             f"\nDiscordant pairs (pooled over passes): right only with history {d['only_with_history']}, "
             f"right only without {d['only_without_history']}.\n")
-        write_results(res.run_dir, results, markdown)
-        print(markdown)
-        check_fallback_share(results)
-        return results
+        return suite_output(results, markdown)

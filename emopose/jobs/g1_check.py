@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from emopose.backends.g1.errors import G1BackendError
-from emopose.contract import GestureRecord, Plan
+from emopose.contract import EventKind, GestureRecord, Plan
 from emopose.resources import Run
-from emopose.results import write_results
+from emopose.results import JobFailure, JobOutput
 
 
 @dataclass
@@ -25,7 +25,7 @@ class G1CheckJob:
     gesture: str = "face_wave"
     intensity: int = 1
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res, session = run.resources, run.session
         entry = res.library.get(self.gesture)
         if entry is None:
@@ -38,7 +38,8 @@ class G1CheckJob:
             session.open()
             measured = res.backend.measured()
             results["measured_start"] = np.asarray(measured).tolist()
-            print(f"connected to {res.backend.name}; measured arm pose (rad): {np.round(measured, 3).tolist()}")
+            print(f"connected to {res.backend.name}; measured arm pose (rad): "
+                  f"{np.round(measured, 3).tolist()}")
             record = GestureRecord(cls=entry.cls, variant=entry.name, intensity=self.intensity)
             turn = run.runner.run_plan(Plan.scripted(f"g1 check: {self.gesture}", record))
             results["completed"] = turn.dispatched.completed
@@ -47,18 +48,17 @@ class G1CheckJob:
             if session.origin is not None:
                 results["fault_at_s"] = round(session.run_time(res.clock.now()), 3)
         results["events"] = [(e.kind, e.name, round(session.run_time(e.t), 3))
-                             for e in events.since(first_event) if e.kind != "state"]
+                             for e in events.since(first_event) if e.kind != EventKind.STATE]
         results["loop"] = session.loop.stats.summary()
-        write_results(res.run_dir, results, self._markdown(results))
-        if results["fault"] is not None:
-            raise SystemExit(f"g1_check: FAULT at {results['fault_at_s']} s: {results['fault']} "
-                             f"(results in {res.run_dir})")
-        print(f"ran {self.gesture} at intensity {self.intensity}: completed={results['completed']}; "
-              f"loop {results['loop']}; releasing (blend to neutral, arm_sdk weight -> 0)")
-        return results
+        if results["fault"] is not None:  # written, then the process exits non-zero with one line
+            raise JobFailure(results, self._markdown(results), SystemExit(
+                f"g1_check: FAULT at {results['fault_at_s']} s: {results['fault']} "
+                f"(results in {res.run_dir})"))
+        return results, self._markdown(results)
 
     def _markdown(self, r: dict) -> str:
-        start = np.round(r["measured_start"], 3).tolist() if r["measured_start"] is not None else "not measured"
+        measured = r["measured_start"]
+        start = np.round(measured, 3).tolist() if measured is not None else "not measured"
         outcome = ("completed" if r["completed"] else "NOT completed") if r["fault"] is None else \
             f"FAULT at {r['fault_at_s']} s: {r['fault']}"
         return "\n".join([

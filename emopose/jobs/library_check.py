@@ -18,10 +18,11 @@ import numpy as np
 
 from emopose import CONTROL_DT
 from emopose.backends.capabilities import Renderable, SimulatedState
+from emopose.backends.stream_tap import StreamTap
 from emopose.jobs.contact_sheet import render_keyframes, render_pose, write_overview, write_sheet
-from emopose.jobs.tracking import StreamTap, tracking_error
+from emopose.jobs.tracking import tracking_error
 from emopose.resources import Resources, Run
-from emopose.results import markdown_table, write_results
+from emopose.results import JobOutput, markdown_table
 from emopose.robot.collision import SelfCollisionChecker
 from emopose.stages.modulate import Modulate
 
@@ -39,9 +40,10 @@ class LibraryCheckJob:
     def __post_init__(self) -> None:
         bad = [i for i in self.intensities if i not in (1, 2, 3, 4, 5)]
         if bad or not self.intensities:
-            raise ValueError(f"library_check: intensities must be a non-empty subset of 1..5, got {self.intensities}")
+            raise ValueError(f"library_check: intensities must be a non-empty subset of 1..5, "
+                             f"got {self.intensities}")
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         backend = res.backend
         if not (isinstance(backend, SimulatedState) and isinstance(backend, Renderable)):
@@ -74,9 +76,7 @@ class LibraryCheckJob:
             write_overview(res.run_dir / "sheets" / "overview.png", res.library, images,
                            {n: self._status(r) for n, r in report.items()})
         results = self._results(report)
-        write_results(res.run_dir, results, self._markdown(results))
-        print(self._markdown(results).split("\n\n")[1])
-        return results
+        return results, self._markdown(results)
 
     # -- one (motion, level) run ---------------------------------------------------------------
     def _run(self, res: Resources, keyframes: np.ndarray, duration: float) -> dict:
@@ -92,7 +92,8 @@ class LibraryCheckJob:
         commands, states = np.array(tap.commands), np.array(tap.states)
         contacts: dict[str, dict] = {}
         for tick, t, pair in tap.contacts:
-            c = contacts.setdefault(f"{pair[0]}|{pair[1]}", {"first_t": t, "last_t": t, "ticks": 0, "tick": tick})
+            c = contacts.setdefault(f"{pair[0]}|{pair[1]}",
+                                    {"first_t": t, "last_t": t, "ticks": 0, "tick": tick})
             c["last_t"], c["ticks"] = t, c["ticks"] + 1
         first_contact = min(contacts.values(), key=lambda c: c["first_t"], default=None)
         reason = res.sequencer.safety(samples) if res.sequencer.safety else None
@@ -130,7 +131,8 @@ class LibraryCheckJob:
             "duration_s": entry.default_duration, "levels": levels,
             "contact_levels": [int(lv) for lv, r in levels.items() if r["contacts"]],
             "contact_pairs": sorted({p for r in levels.values() for p in r["contacts"]}),
-            "min_margin_rad": worst[1]["margin_cmd"]["rad"], "min_margin_joint": worst[1]["margin_cmd"]["joint"],
+            "min_margin_rad": worst[1]["margin_cmd"]["rad"],
+            "min_margin_joint": worst[1]["margin_cmd"]["joint"],
             "min_margin_level": int(worst[0]),
             "level3_margin_rad": levels.get("3", worst[1])["margin_cmd"]["rad"],
             "min_capsule_clearance_m": min(r["capsule_clearance_m"] for r in levels.values()),
@@ -163,7 +165,8 @@ class LibraryCheckJob:
         rows = []
         for name, r in results["per_motion"].items():
             rows.append([name, r["class"], r["keyframes"], f"{r['duration_s']:.2f}",
-                         ",".join(map(str, r["contact_levels"])) or "-", "; ".join(r["contact_pairs"]) or "-",
+                         ",".join(map(str, r["contact_levels"])) or "-",
+                         "; ".join(r["contact_pairs"]) or "-",
                          f"{r['min_margin_rad']:.3f} {r['min_margin_joint']} (L{r['min_margin_level']})",
                          f"{r['min_capsule_clearance_m'] * 100:.1f}",
                          ",".join(map(str, r["rejected_levels"])) or "-",
@@ -176,9 +179,10 @@ class LibraryCheckJob:
             table,
             (f"Motions with MJCF self-contacts: {results['with_contacts'] or 'none'}. "
              f"Rejected by the configured safety check: {results['safety_rejections'] or 'none'}. "
-             f"Smallest commanded joint-limit margin {results['min_margin_rad']:.3f} rad; peak actuator-force "
-             f"ratio {results['max_force_ratio']:.2f}. Each run starts at rest in the neutral pose; the "
-             f"trajectory is held {results['hold_s']} s after it ends. Contact sheets: sheets/<motion>.png."),
+             f"Smallest commanded joint-limit margin {results['min_margin_rad']:.3f} rad; peak "
+             f"actuator-force ratio {results['max_force_ratio']:.2f}. Each run starts at rest in the neutral "
+             f"pose; the trajectory is held {results['hold_s']} s after it ends. "
+             f"Contact sheets: sheets/<motion>.png."),
         ])
 
 

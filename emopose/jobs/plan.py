@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from emopose.contract import EventKind
 from emopose.resources import Run
-from emopose.results import markdown_table, write_results
+from emopose.results import JobOutput, markdown_table
 
 
 @dataclass
@@ -13,7 +14,7 @@ class PlanJob:
     utterance: str
     image: str | None = None
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         if not self.utterance.strip():
             raise ValueError("utterance is empty: pass utterance=\"...\"")
         res = run.resources
@@ -24,8 +25,9 @@ class PlanJob:
             r = resolved.record
             rows.append([r.cls, r.variant or "-", resolved.entry.name, resolved.rule, r.intensity,
                          r.trigger or "-", f"{release.release_s:.2f} s ({release.how})"])
-        table = markdown_table(["class", "requested", "resolved", "rule", "intensity", "trigger", "release"], rows)
-        started = [e for e in turn.dispatched.events if e.kind == "started"]
+        table = markdown_table(["class", "requested", "resolved", "rule", "intensity", "trigger", "release"],
+                               rows)
+        started = [e for e in turn.dispatched.events if e.kind == EventKind.STARTED]
         data = turn.to_json()
         results = {
             "utterance": self.utterance,
@@ -46,6 +48,4 @@ class PlanJob:
                 f"planner {res.planner.name})\n\n{table}\n\nSpeech {turn.speech.duration_s:.2f} s; "
                 f"{len(started)} gesture(s) executed on {res.backend.name}; "
                 f"recording: {results['mcap']}")
-        write_results(res.run_dir, results, text)
-        print(text)
-        return results
+        return results, text

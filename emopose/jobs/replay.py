@@ -15,11 +15,12 @@ import numpy as np
 
 from emopose import CONTROL_DT, NUM_JOINTS
 from emopose.backends.capabilities import SimulatedState
+from emopose.backends.stream_tap import StreamTap
 from emopose.jobs.contact_sheet import view
-from emopose.jobs.tracking import StreamTap, tracking_error
+from emopose.jobs.tracking import tracking_error
 from emopose.recording import Recorder, read_recording
 from emopose.resources import Run
-from emopose.results import write_results
+from emopose.results import JobOutput
 
 
 def command_grid(rows: list[tuple[float, dict]], dt: float = CONTROL_DT) -> tuple[np.ndarray, np.ndarray]:
@@ -53,11 +54,12 @@ class ReplayJob:
         if self.render_every < 1:
             raise ValueError(f"replay: render_every must be >= 1, got {self.render_every}")
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         streams = read_recording(self.mcap)
         if not streams.get(self.topic):
-            raise ValueError(f"replay: {self.mcap} has no messages on {self.topic}; topics: {sorted(streams)}")
+            raise ValueError(f"replay: {self.mcap} has no messages on {self.topic}; "
+                             f"topics: {sorted(streams)}")
         times, commands = command_grid(streams[self.topic])
         if self.max_seconds is not None:
             keep = times - times[0] <= self.max_seconds + 1e-9
@@ -93,16 +95,17 @@ class ReplayJob:
             "self_contacts": sorted({f"{p[0]}|{p[1]}" for _, _, p in tap.contacts}),
             "video": str(video) if video else None,
         }
-        text = (f"# Replay of {self.mcap}\n\n{len(times)} ticks ({results['duration_s']:.2f} s) of {self.topic} "
-                f"replayed in MuJoCo.\n\nTracking MAE {results['mae_rad']:.5f} rad over every tick "
+        return results, self._markdown(results)
+
+    @staticmethod
+    def _markdown(r: dict) -> str:
+        return (f"# Replay of {r['mcap']}\n\n{r['ticks']} ticks ({r['duration_s']:.2f} s) of {r['topic']} "
+                f"replayed in MuJoCo.\n\nTracking MAE {r['mae_rad']:.5f} rad over every tick "
                 f"(command n vs the pose after tick n's physics; N=100 resampled: "
-                f"{results['mae_resampled_rad']:.5f}; time-aligned: {results['mae_time_aligned_rad']:.5f}); "
-                f"peak {results['max_abs_error_rad']:.4f} rad. Max actuator-force ratio "
-                f"{results['max_actuator_force_ratio']:.3f}. Self-contacts: {results['self_contacts'] or 'none'}."
-                f"\n\nVideo: {results['video'] or 'not rendered'}")
-        write_results(res.run_dir, results, text)
-        print(text)
-        return results
+                f"{r['mae_resampled_rad']:.5f}; time-aligned: {r['mae_time_aligned_rad']:.5f}); "
+                f"peak {r['max_abs_error_rad']:.4f} rad. Max actuator-force ratio "
+                f"{r['max_actuator_force_ratio']:.3f}. Self-contacts: {r['self_contacts'] or 'none'}."
+                f"\n\nVideo: {r['video'] or 'not rendered'}")
 
     def _sink(self, run_dir: Path):
         if not self.video:

@@ -18,14 +18,14 @@ from emopose.bench.tables import comparison_markdown
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     PlannedItem,
-    check_fallback_share,
     plan_suite,
     resolve_passes,
     run_summary,
+    suite_output,
 )
 from emopose.planners.base import PlanRequest
 from emopose.resources import Run
-from emopose.results import write_results
+from emopose.results import JobOutput
 
 COUNT_KEYS = ("over", "under", "failed")
 
@@ -47,7 +47,7 @@ class SequenceSuiteJob:
     progress: bool = True
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         entries = res.library.snapshot.entries
         variant_classes = {name: e.cls for name, e in entries.items()} if self.check_variants else None
@@ -65,8 +65,9 @@ class SequenceSuiteJob:
             preds = [as_prediction(o) for o in planned]
             per_pass.append(suite_scores(items, preds))
             for item, pred, outcome in zip(items, preds, planned):
-                predictions.append({"id": item.id, "labels": list(item.labels), "pred": None if pred.classes is None
-                                    else list(pred.classes), "triggers": list(pred.triggers),
+                predictions.append({"id": item.id, "labels": list(item.labels),
+                                    "pred": None if pred.classes is None else list(pred.classes),
+                                    "triggers": list(pred.triggers),
                                     "variants": list(pred.variants), "pass": p, "source": outcome.source})
         rates = [{k: v for k, v in scores.items() if k not in COUNT_KEYS} for scores in per_pass]
         results = {
@@ -86,7 +87,4 @@ class SequenceSuiteJob:
         markdown = comparison_markdown([results]) + (
             f"\nPooled over {passes} pass(es) x {len(items)} plans: {seg['over_total']} over-segmented, "
             f"{seg['under_total']} under-segmented, {seg['failed_total']} failed.\n")
-        write_results(res.run_dir, results, markdown)
-        print(markdown)
-        check_fallback_share(results)
-        return results
+        return suite_output(results, markdown)

@@ -13,9 +13,8 @@ import logging
 from dataclasses import dataclass, field
 
 from emopose.build import ConfigError
-from emopose.clock import MonotonicClock
 from emopose.resources import Run
-from emopose.results import write_results
+from emopose.results import JobOutput
 from emopose.web.settings import ServeSettings
 
 log = logging.getLogger(__name__)
@@ -29,16 +28,18 @@ class ServeJob:
     def __post_init__(self) -> None:
         self.settings = ServeSettings.from_config(self.serve)
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
-        if not isinstance(res.clock, MonotonicClock):
-            raise ConfigError("serve needs real time: run with run.clock=monotonic (the serve experiment sets it)")
+        if not res.clock.realtime:
+            raise ConfigError("serve needs real time: run with run.clock=monotonic "
+                              "(the serve experiment sets it)")
         import uvicorn  # the web extras load only when serving
 
         from emopose.web.app import create_app
         from emopose.web.live import open_session
 
-        session = open_session(run, self.settings, render=self.render)  # renderer first: its setup holds the GIL
+        # The renderer first: its setup holds the GIL.
+        session = open_session(run, self.settings, render=self.render)
         loop = run.session.open()
         try:
             loop.start()
@@ -54,6 +55,5 @@ class ServeJob:
         turns = [m for m in session.log_since(0) if m["type"] == "turn"]
         results = {"turns": len(turns), "backend": res.backend.name, "planner": res.planner.name,
                    "library_version": res.library.version, "loop": loop.stats.summary()}
-        write_results(res.run_dir, results, f"Served {len(turns)} turn(s) on {res.backend.name} with "
-                                            f"planner {res.planner.name}; control loop {results['loop']}")
-        return results
+        return results, (f"Served {len(turns)} turn(s) on {res.backend.name} with planner "
+                         f"{res.planner.name}; control loop {results['loop']}")

@@ -26,13 +26,15 @@ def _ms(stats: dict) -> str:
     return f"{stats['mean']:.3f} / {stats['p95']:.3f} ms"
 
 
-def suite_markdown(r: dict) -> str:
+def _paper_table(r: dict) -> str:
+    """The paper's Table execution beside this run (and the compared arm law's MAE, if any)."""
     per_class = [v for v in r["per_class_mae_rad"].values() if not math.isnan(v)]
     class_range = f"{min(per_class):.5f}-{max(per_class):.5f} rad" if per_class else "-"
+    rejected = f" (+{r['rejected']} rejected)" if r["rejected"] else ""
     ours = {
         "trials": f"{r['trials']} / {len(set(r['motions'].values()))} defaults / level {r['intensity']}",
         "completed": f"{r['completed']}/{r['trials']}",
-        "stops_timeouts": f"{r['stops']} / {r['timeouts']}" + (f" (+{r['rejected']} rejected)" if r["rejected"] else ""),
+        "stops_timeouts": f"{r['stops']} / {r['timeouts']}" + rejected,
         "mae": f"{r['mae_rad']:.5f} rad ({r['mae_deg']:.2f} deg)",
         "class_range": class_range,
         "vlm": "n/a (scripted records; no model call)",
@@ -54,24 +56,29 @@ def suite_markdown(r: dict) -> str:
         labels = dict([*list(labels.items())[:at], ("compare", f"... under the {c['arm_law']} arm law"),
                        *list(labels.items())[at:]])
         ours["compare"], paper["compare"] = f"{c['mae_rad']:.5f} rad ({c['mae_deg']:.2f} deg)", "-"
-    table = markdown_table(["Metric", "Paper", "This run"], [[labels[k], paper[k], ours[k]] for k in labels])
+    return markdown_table(["Metric", "Paper", "This run"], [[labels[k], paper[k], ours[k]] for k in labels])
+
+
+def suite_markdown(r: dict) -> str:
     classes = markdown_table(
         ["class", "motion", "MAE tick (rad)", "MAE time-aligned (rad)", "max force ratio"],
-        [[c, r["motions"][c], f"{r['per_class_mae_rad'][c]:.5f}", f"{r['per_class_mae_time_aligned_rad'][c]:.5f}",
+        [[c, r["motions"][c], f"{r['per_class_mae_rad'][c]:.5f}",
+          f"{r['per_class_mae_time_aligned_rad'][c]:.5f}",
           f"{r['per_class_max_actuator_force_ratio'][c]:.3f}"] for c in CLASSES])
     return "\n\n".join([
         f"# Sim suite ({r['backend']}, {r['trials']} trials, dispatch until={r['dispatch_until']})",
-        table,
+        _paper_table(r),
         "## Per class",
         classes,
         "## What is compared",
         (f"Each trial's window runs from its `started` tick to its `completed` tick (the whole constructed "
-         f"trajectory, initial transition included); both streams are linearly resampled to N={r['points']} "
-         f"points and averaged over trials, points and 14 joints (Eq. sim-MAE). Alignment: {r['alignment']}. "
+         f"trajectory, initial transition included); both streams are linearly resampled to "
+         f"N={r['points']} points and averaged over trials, points and 14 joints (Eq. sim-MAE). "
+         f"Alignment: {r['alignment']}. "
          f"The headline MAE uses the tick alignment; the time-aligned MAE "
          f"({r['mae_time_aligned_rad']:.5f} rad) adds one control period of lag. Peak |error| "
-         f"{r['max_abs_error_rad']:.4f} rad. Starting poses ({r['start_from']}): the previous trial's held end "
-         f"pose or the neutral pose after the sequencer's recovery; mean offset from the motion's first "
+         f"{r['max_abs_error_rad']:.4f} rad. Starting poses ({r['start_from']}): the previous trial's held "
+         f"end pose or the neutral pose after the sequencer's recovery; mean offset from the motion's first "
          f"keyframe {r['start_offset_rad']['previous']:.3f} / {r['start_offset_rad']['rest']:.3f} rad."),
         (f"Max actuator-force ratio |tau|/limit (servo + gravity compensation): "
          f"{r['max_actuator_force_ratio']:.3f}; robot self-contacts during trials: {r['self_contacts']}. "

@@ -22,12 +22,13 @@ import numpy as np
 
 from emopose import CLASSES
 from emopose.backends.capabilities import SimulatedState
-from emopose.contract import GestureRecord, Plan
-from emopose.execution.sequencer import State
+from emopose.backends.stream_tap import StreamTap
+from emopose.contract import EventKind, GestureRecord, Plan
+from emopose.execution.gesture_command import State
 from emopose.jobs.sim_report import suite_markdown
-from emopose.jobs.tracking import StreamTap, latency_ms, sim_mae, tracking_error
+from emopose.jobs.tracking import latency_ms, sim_mae, tracking_error
 from emopose.resources import Run
-from emopose.results import write_results
+from emopose.results import JobOutput
 from emopose.robot.arm_law import ArmLaw
 
 log = logging.getLogger(__name__)
@@ -53,7 +54,7 @@ class SimSuiteJob:
         if not 1 <= self.intensity <= 5:
             raise ValueError(f"sim_suite: intensity must be 1..5, got {self.intensity}")
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         motions = {c: res.library.class_default(c) for c in CLASSES}
         missing = [c for c, m in motions.items() if m is None]
@@ -70,21 +71,21 @@ class SimSuiteJob:
         results["arm_law"] = None if simulator is None else simulator.law.name
         if simulator is not None and self.compare_law is not None:
             results["compare"] = self._under(run, tap, t0, order, motions, simulator, self.compare_law)
-        write_results(res.run_dir, results, suite_markdown(results))
         (res.run_dir / "trials.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
-        print(suite_markdown(results).split("\n\n")[1])
-        return results
+        return results, suite_markdown(results)
 
     def _under(self, run: Run, tap: StreamTap, t0: float, order, motions, simulator, law: ArmLaw) -> dict:
         """The same trials with the servos under `law`; the configured law is restored after."""
         configured = simulator.law
         simulator.apply_law(law)
         try:
-            rows = [self._trial(run, tap, t0, k, str(cls), motions[str(cls)].name) for k, cls in enumerate(order)]
+            rows = [self._trial(run, tap, t0, k, str(cls), motions[str(cls)].name)
+                    for k, cls in enumerate(order)]
         finally:
             simulator.apply_law(configured)
         summary = self._summarise(run, rows)
-        keys = ("completed", "mae_rad", "mae_deg", "per_class_mae_rad", "mae_time_aligned_rad", "max_abs_error_rad")
+        keys = ("completed", "mae_rad", "mae_deg", "per_class_mae_rad", "mae_time_aligned_rad",
+                "max_abs_error_rad")
         return {"arm_law": law.name, **{k: summary[k] for k in keys}}
 
     def _start_mode(self, k: int) -> str:
@@ -109,13 +110,16 @@ class SimSuiteJob:
         kinds = {e.kind for e in mine}
         row = {"trial": k, "class": cls, "motion": turn.resolved[0].entry.name, "start": start,
                "start_offset_rad": float(np.max(np.abs(q_start - command.keyframes[0]))),
-               "completed": "completed" in kinds and not kinds & {"stopped", "rejected"} and report.completed,
-               "stopped": "stopped" in kinds, "rejected": "rejected" in kinds, "timeout": not report.completed,
+               "completed": (EventKind.COMPLETED in kinds
+                             and not kinds & {EventKind.STOPPED, EventKind.REJECTED}
+                             and report.completed),
+               "stopped": EventKind.STOPPED in kinds, "rejected": EventKind.REJECTED in kinds,
+               "timeout": not report.completed,
                "construction_s": sequencer.construction_s.since(first_build),
                "submission_s": list(turn.submitted.submission_s)}
         row["force_ratio"] = simulated.max_actuator_force_ratio if simulated is not None else float("nan")
-        started = next((e for e in mine if e.kind == "started"), None)
-        done = next((e for e in mine if e.kind == "completed"), None)
+        started = next((e for e in mine if e.kind == EventKind.STARTED), None)
+        done = next((e for e in mine if e.kind == EventKind.COMPLETED), None)
         if started is None or done is None:
             log.warning("trial %d (%s) did not complete: %s", k, cls, sorted(kinds))
             return row
@@ -138,7 +142,8 @@ class SimSuiteJob:
             per_class[cls] = sim_mae(mine)
             per_class_time[cls] = sim_mae(mine, "time")
             per_class_force[cls] = max((r["force_ratio"] for r in rows if r["class"] == cls), default=0.0)
-        contacts = [{"trial": r["trial"], "class": r["class"], "pair": p} for r in done for p in r["contacts"]]
+        contacts = [{"trial": r["trial"], "class": r["class"], "pair": p}
+                    for r in done for p in r["contacts"]]
         mae = sim_mae(errors)
         return {
             "trials": len(rows),
@@ -158,8 +163,9 @@ class SimSuiteJob:
             "self_contact_pairs": contacts[:50],
             "construction_ms": latency_ms([s for r in rows for s in r["construction_s"]]),
             "submission_ms": latency_ms([s for r in rows for s in r["submission_s"]]),
-            "start_offset_rad": {m: float(np.mean([r["start_offset_rad"] for r in rows if r["start"] == m] or [0]))
-                                 for m in ("previous", "rest")},
+            "start_offset_rad": {
+                m: float(np.mean([r["start_offset_rad"] for r in rows if r["start"] == m] or [0]))
+                for m in ("previous", "rest")},
             "motions": {c: res.library.class_default(c).name for c in CLASSES},
             "intensity": self.intensity,
             "start_from": self.start_from,

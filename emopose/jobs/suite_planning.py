@@ -6,7 +6,7 @@ retried one by one, and an item whose planner call raises is recorded as a failu
 the run continues; a PlannerFailure (the planner cannot answer at all) stops the run instead. Every
 answer is parsed with the one contract parser (parse_output), whose Plan.source is each prediction's
 source; `fallbacks` counts every answer that is not a usable model record, and a run whose fallback
-share exceeds `max_fallback_share` is written, marked, and then fails (check_fallback_share).
+share exceeds `max_fallback_share` is written, marked, and then fails (suite_output).
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ import numpy as np
 
 from emopose.contract import Plan
 from emopose.planners.base import Planner, PlannerFailure, PlannerOutput, PlanRequest, plan_all
+from emopose.results import JobFailure, JobOutput
 from emopose.stages.parse import parse_output
 
 log = logging.getLogger(__name__)
@@ -60,7 +61,7 @@ class PlannedItem:
 def resolve_passes(passes: int | None, planner: Planner) -> int:
     """`passes` as configured, or by default 5 for a sampled planner (planner.sampled) and 1 otherwise."""
     if passes is None:
-        return SAMPLED_PASSES if getattr(planner, "sampled", False) else 1
+        return SAMPLED_PASSES if planner.sampled else 1
     if int(passes) < 1:
         raise ValueError(f"passes must be >= 1, got {passes}")
     return int(passes)
@@ -110,13 +111,15 @@ def plan_suite(planner: Planner, requests: Sequence[PlanRequest], label: str = "
 
 def latency_summary(items: Sequence[PlannedItem], attribute: str = "latency_s") -> dict:
     """Planner latency (or queueing) in seconds: mean and 95th percentile over items that have one."""
-    values = np.array([getattr(i, attribute) for i in items if getattr(i, attribute) is not None], dtype=float)
+    values = np.array([getattr(i, attribute) for i in items if getattr(i, attribute) is not None],
+                      dtype=float)
     if values.size == 0:
         return {"mean": None, "p95": None}
     return {"mean": float(values.mean()), "p95": float(np.percentile(values, 95))}
 
 
-def run_summary(planned: Sequence[PlannedItem], started: float, max_fallback_share: float = MAX_FALLBACK_SHARE) -> dict:
+def run_summary(planned: Sequence[PlannedItem], started: float,
+                max_fallback_share: float = MAX_FALLBACK_SHARE) -> dict:
     """The fields every suite job reports about its planning run: fallbacks (and their share of all
     answers, against the limit), failures, the count of each source, latency and wall time."""
     if not 0.0 <= max_fallback_share <= 1.0:
@@ -130,11 +133,13 @@ def run_summary(planned: Sequence[PlannedItem], started: float, max_fallback_sha
             "wall_s": time.perf_counter() - started}
 
 
-def check_fallback_share(results: dict) -> None:
-    """After the results are written: a run that fell back too often fails (exit 2) rather than pass
-    the keyword rules off as the planner's score."""
-    if results.get("fallback_exceeded"):
-        raise PlannerFailure(
+def suite_output(results: dict, markdown: str) -> JobOutput:
+    """What a suite job returns. A run that fell back too often is written and printed all the same,
+    then fails (exit 2) rather than pass the keyword rules off as the planner's score."""
+    if results["fallback_exceeded"]:
+        raise JobFailure(results, markdown, PlannerFailure(
             f"planner {results['method']} fell back on {results['fallbacks']} answers "
-            f"({100 * results['fallback_share']:.1f} % > job.max_fallback_share {100 * results['max_fallback_share']:.0f} %;"
-            f" sources {results['sources']}); the results are written and marked, but are not the planner's score")
+            f"({100 * results['fallback_share']:.1f} % > job.max_fallback_share "
+            f"{100 * results['max_fallback_share']:.0f} %; sources {results['sources']}); the results are "
+            f"written and marked, but are not the planner's score"))
+    return results, markdown

@@ -18,15 +18,15 @@ A few items per mode are drawn as timelines (words, planned and executed strokes
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from emopose.clock import FakeClock
-from emopose.jobs.tracking import StreamTap
+from emopose.backends.stream_tap import StreamTap
+from emopose.bench.suites import SequenceItem, load_sequence
 from emopose.resources import Resources, Run
-from emopose.results import markdown_table, write_results
+from emopose.results import JobOutput, markdown_table
 from emopose.speech.espeak import EspeakSynthesizer
 from emopose.sync.plot import plot_timelines
 from emopose.sync.strokes import (
@@ -37,7 +37,7 @@ from emopose.sync.strokes import (
     stroke_summary,
     unmet_targets,
 )
-from emopose.sync.words import GestureSync, SuiteItem, load_suite, measure_turn, summarize
+from emopose.sync.words import GestureSync, measure_turn, summarize
 from emopose.turn.pipeline import Pipeline
 from emopose.turn.runner import TurnRunner
 
@@ -54,12 +54,12 @@ class SyncEvalJob:
     plots: int = 4               # items drawn as timelines per mode
     stroke_targets: dict[str, float] = field(default_factory=dict)  # stroke_summary key -> bound (see yaml)
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         if not isinstance(res.synthesizer, EspeakSynthesizer):
             raise ValueError(f"sync_eval measures against the engine's own word events, but tts is "
                              f"{res.synthesizer.name!r}: run it with tts=espeak")
-        if not isinstance(res.clock, FakeClock):
+        if res.clock.realtime:
             raise ValueError("sync_eval runs on virtual time: use backend=dry_run with run.clock=auto")
         suite_path, items = self._items()
         run.session.open()
@@ -76,18 +76,20 @@ class SyncEvalJob:
                 if number < self.plots:
                     plot_timelines(res.run_dir / f"timeline_{mode}_{item.id}.png", item, turn, stroke)
         results = self._results(run, suite_path, items, rows, strokes, simulated=tap.simulated)
-        write_results(res.run_dir, results, self._markdown(results))
-        print(self._markdown(results))
-        return results
+        return results, self._markdown(results)
 
-    def _items(self) -> tuple[Path, list[SuiteItem]]:
+    def _items(self) -> tuple[Path, list[SequenceItem]]:
+        """The suite's items (the first `limit`); an anchor missing from its text is kept: the say-do
+        check reports it."""
         path = Path(self.suite)
         if not path.exists():
             if not self.fallback_suite:
-                raise FileNotFoundError(f"job.suite {path} does not exist (set job.suite or job.fallback_suite)")
-            log.warning("sequence suite %s is missing; measuring the fixture %s instead", path, self.fallback_suite)
+                raise FileNotFoundError(f"job.suite {path} does not exist "
+                                        "(set job.suite or job.fallback_suite)")
+            log.warning("sequence suite %s is missing; measuring the fixture %s instead",
+                        path, self.fallback_suite)
             path = Path(self.fallback_suite)
-        return path, load_suite(path, self.limit)
+        return path, load_sequence(path, anchors_in_text=False)[:self.limit]
 
     @staticmethod
     def _pipeline(configured: Pipeline, mode: str) -> Pipeline:
@@ -97,11 +99,11 @@ class SyncEvalJob:
         missing = [n for n, stage in stages.items() if stage is None]
         if missing:
             raise ValueError(f"sync_eval needs pipeline stages {missing}; pipeline has {configured.names}")
-        return Pipeline([stages["resolve"], stages["modulate"], replace(stages["schedule"], mode=mode),
-                         replace(stages["sequence"], interrupt=False), replace(stages["dispatch"], until="rest")],
+        return Pipeline([stages["resolve"], stages["modulate"], stages["schedule"].in_mode(mode),
+                         stages["sequence"].queueing(), stages["dispatch"].waiting_until("rest")],
                         inputs=("request", "plan"))
 
-    def _run_item(self, res: Resources, runner: TurnRunner, item: SuiteItem, tap: StreamTap):
+    def _run_item(self, res: Resources, runner: TurnRunner, item: SequenceItem, tap: StreamTap):
         first = len(tap)
         turn = runner.run_plan(item.plan(), utterance=item.text)
         if not turn.dispatched.completed:
@@ -110,24 +112,28 @@ class SyncEvalJob:
         loop = runner.session.loop
         times = np.asarray(tap.times[first:]) + (loop.clock.now() - loop.stream_time)  # stream -> clock time
         simulated = tap.simulated
-        streams = Streams([(e.t, e.kind, e.command_id) for e in turn.dispatched.events], turn.dispatched.speech_start,
-                          times, np.asarray(tap.commands[first:]), times + loop.dt if simulated else None,
+        streams = Streams([(e.t, e.kind, e.command_id) for e in turn.dispatched.events],
+                          turn.dispatched.speech_start, times, np.asarray(tap.commands[first:]),
+                          times + loop.dt if simulated else None,
                           np.asarray(tap.states[first:]) if simulated else None)
         strokes = measure_strokes(item.id, planned_strokes(turn), [r.onset_s for r in sync], streams,
                                   turn.schedule.preroll_s)
         return sync, strokes, turn
 
-    def _results(self, run: Run, suite_path: Path, items: list[SuiteItem], rows: dict, strokes: dict,
+    def _results(self, run: Run, suite_path: Path, items: list[SequenceItem], rows: dict, strokes: dict,
                  simulated: bool) -> dict:
         summaries = {mode: summarize(r) for mode, r in rows.items()}
         for mode, stroke_rows in strokes.items():
-            for key, sim in (("stroke_vs_onset", False), ("stroke_vs_onset_simulated", True))[:1 + simulated]:
+            streams = (("stroke_vs_onset", False), ("stroke_vs_onset_simulated", True))[:1 + simulated]
+            for key, sim in streams:
                 summary = stroke_summary(stroke_rows, simulated=sim)
-                summaries[mode][key] = {**summary, "unmet_targets": unmet_targets(summary, self.stroke_targets)}
+                unmet = unmet_targets(summary, self.stroke_targets)
+                summaries[mode][key] = {**summary, "unmet_targets": unmet}
         missing = [{"item": r.item, "k": r.k, "trigger": r.trigger}
                    for r in next(iter(rows.values()), []) if not r.found]
         for m in missing:
-            log.warning("say-do check: item %s record %d trigger %r is not in the reply", m["item"], m["k"], m["trigger"])
+            log.warning("say-do check: item %s record %d trigger %r is not in the reply",
+                        m["item"], m["k"], m["trigger"])
         words_p95 = summaries.get("words", {}).get("scheduled_vs_onset", {}).get("p95_abs_ms")
         speech = run.resources.synthesizer
         return {
@@ -144,45 +150,59 @@ class SyncEvalJob:
 
     @staticmethod
     def _markdown(results: dict) -> str:
-        def ms(stats: dict, key: str) -> str:
-            return "-" if stats[key] is None else f"{stats[key]:.0f}"
-
-        header = ["mode", "gestures", "measured", "scheduled-onset mean abs (ms)", "p95", "mean signed",
-                  "actual-onset mean abs (ms)", "p95", "p95 unqueued", "queued", "queue delay mean (ms)",
-                  "scheduled-center p95 (ms)"]
-        rows = []
-        for mode, s in results["modes"].items():
-            sched, actual, unq = s["scheduled_vs_onset"], s["actual_vs_onset"], s["actual_vs_onset_unqueued"]
-            rows.append([mode, s["gestures"], s["measured"], ms(sched, "mean_abs_ms"), ms(sched, "p95_abs_ms"),
-                         ms(sched, "mean_signed_ms"), ms(actual, "mean_abs_ms"), ms(actual, "p95_abs_ms"),
-                         ms(unq, "p95_abs_ms"), s["queued"], ms(s["queue_delay"], "mean_abs_ms"),
-                         ms(s["scheduled_vs_center"], "p95_abs_ms")])
-        stroke_header = ["mode", "stream", "planned", "arrived", "within [-200, +100] ms", "median |offset| (ms)",
-                         "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)", "targets"]
-        stroke_rows = []
-        for mode, s in results["modes"].items():
-            for stream, key in (("command", "stroke_vs_onset"), ("simulated", "stroke_vs_onset_simulated")):
-                if key in s:
-                    st = s[key]
-                    stroke_rows.append([mode, stream, st["n"], st["arrived"], f"{st['within_window_share']:.3f}",
-                                        ms(st, "median_abs_ms"), ms(st, "p95_abs_ms"), ms(st, "median_signed_ms"),
-                                        f"{st['dropped_share']:.3f}", f"{st['preroll_p95_ms']:.0f}",
-                                        "met" if not st["unmet_targets"] else "missed"])
-        target = results["target"]
-        say_do = results["say_do"]
+        target, say_do = results["target"], results["say_do"]
         flagged = ", ".join(f"{m['item']}#{m['k']} {m['trigger']!r}" for m in say_do["records"]) or "none"
         return (f"# Speech-gesture sync ({results['items']} items from {results['suite']})\n\n"
                 f"True onsets: {results['tts']['engine']} word events (voice {results['tts']['voice']}, "
-                f"rate {results['tts']['rate']} wpm).\n\n{markdown_table(header, rows)}\n\n"
-                "## Where the executed strokes land\n\nExecuted stroke start: the first tick at which the stream "
-                "comes within 0.05 rad of the gesture's stroke-start keyframe; offset from the trigger word's onset "
-                f"(negative: before it). Targets (within: at least; the others: at most): "
-                f"{results['stroke_targets']}.\n\n{markdown_table(stroke_header, stroke_rows)}\n\n"
-                f"Target: words-mode p95 |scheduled - onset| <= {target['words_p95_scheduled_vs_onset_ms']:.0f} ms: "
+                f"rate {results['tts']['rate']} wpm).\n\n"
+                f"{_release_table(results['modes'])}\n\n"
+                "## Where the executed strokes land\n\nExecuted stroke start: the first tick at which the "
+                "stream comes within 0.05 rad of the gesture's stroke-start keyframe; offset from the "
+                "trigger word's onset (negative: before it). Targets (within: at least; the others: "
+                f"at most): {results['stroke_targets']}.\n\n{_stroke_table(results['modes'])}\n\n"
+                f"Target: words-mode p95 |scheduled - onset| <= "
+                f"{target['words_p95_scheduled_vs_onset_ms']:.0f} ms: "
                 f"{'met' if target['met'] else 'NOT met'} ({target['value_ms']}).\n\n"
-                f"Say-do check: {say_do['missing']} record(s) whose trigger is not in the reply: {flagged}.\n\n"
+                f"Say-do check: {say_do['missing']} record(s) whose trigger is not in the reply: "
+                f"{flagged}.\n\n"
                 "scheduled vs onset is the scheduler's error; actual vs onset adds what execution does: the "
-                "sequencer releases only on 50 Hz ticks (0-20 ms later), and a gesture whose predecessor is still "
-                "running starts only after it ends plus the <= 0.3 s blend (\"queued\"); unqueued p95 leaves those out. "
-                "The anchor equation aims at the phrase center, not its onset; scheduled-center shows its error "
-                "against that target (center: midway between the phrase onset and the next word's onset).\n")
+                "sequencer releases only on 50 Hz ticks (0-20 ms later), and a gesture whose predecessor is "
+                "still running starts only after it ends plus the <= 0.3 s blend (\"queued\"); unqueued p95 "
+                "leaves those out. The anchor equation aims at the phrase center, not its onset; "
+                "scheduled-center shows its error against that target (center: midway between the phrase "
+                "onset and the next word's onset).\n")
+
+
+def _ms(stats: dict, key: str) -> str:
+    return "-" if stats[key] is None else f"{stats[key]:.0f}"
+
+
+def _release_table(modes: dict) -> str:
+    """Scheduled and actual release times against the onsets, per mode."""
+    header = ["mode", "gestures", "measured", "scheduled-onset mean abs (ms)", "p95", "mean signed",
+              "actual-onset mean abs (ms)", "p95", "p95 unqueued", "queued", "queue delay mean (ms)",
+              "scheduled-center p95 (ms)"]
+    rows = []
+    for mode, s in modes.items():
+        sched, actual, unq = s["scheduled_vs_onset"], s["actual_vs_onset"], s["actual_vs_onset_unqueued"]
+        rows.append([mode, s["gestures"], s["measured"], _ms(sched, "mean_abs_ms"), _ms(sched, "p95_abs_ms"),
+                     _ms(sched, "mean_signed_ms"), _ms(actual, "mean_abs_ms"), _ms(actual, "p95_abs_ms"),
+                     _ms(unq, "p95_abs_ms"), s["queued"], _ms(s["queue_delay"], "mean_abs_ms"),
+                     _ms(s["scheduled_vs_center"], "p95_abs_ms")])
+    return markdown_table(header, rows)
+
+
+def _stroke_table(modes: dict) -> str:
+    """Where the executed strokes land, per mode and stream (command, and simulated when there is one)."""
+    header = ["mode", "stream", "planned", "arrived", "within [-200, +100] ms", "median |offset| (ms)",
+              "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)", "targets"]
+    rows = []
+    for mode, s in modes.items():
+        for stream, key in (("command", "stroke_vs_onset"), ("simulated", "stroke_vs_onset_simulated")):
+            if key in s:
+                st = s[key]
+                rows.append([mode, stream, st["n"], st["arrived"], f"{st['within_window_share']:.3f}",
+                             _ms(st, "median_abs_ms"), _ms(st, "p95_abs_ms"), _ms(st, "median_signed_ms"),
+                             f"{st['dropped_share']:.3f}", f"{st['preroll_p95_ms']:.0f}",
+                             "met" if not st["unmet_targets"] else "missed"])
+    return markdown_table(header, rows)

@@ -1,7 +1,7 @@
 """+experiment=train_local: train the local planner and score it on the held-out training slice.
 
-Training is planners/local_artifact.train_artifact, which the planner's first use calls too: building
-the run trains when no cached artifact matches the training files and hyper-parameters, and
+This is where training belongs: building the run trains when no cached artifact matches the training
+files and hyper-parameters (the experiment sets planner.train_if_missing; LocalPlanner.from_config), and
 `job.retrain=true` trains again even when one does (progress bars with ETA on stderr). The held-out
 slice is every training item (single-act, multi-act and dialogue) whose id hashes into
 planner.training.holdout_percent; those never enter training. Dialogues are scored with and without
@@ -20,9 +20,15 @@ from emopose.bench.suites import SequenceItem
 from emopose.planners.local.data import Example, load_examples
 from emopose.planners.local.planner import LocalPlanner, ScoredUtterance, trigger_span
 from emopose.resources import Run
-from emopose.results import markdown_table, write_results
+from emopose.results import JobOutput, markdown_table
 
 SPLIT_PARAMETERS = ("temperature", "boundary_weight", "act_cost")
+
+
+def held_out_examples(planner: LocalPlanner) -> list[Example]:
+    """The training items held out of the planner's training (planner.training.holdout_percent)."""
+    settings = planner.settings
+    return load_examples(settings.train_files, settings.training.holdout_percent, held_out=True)
 
 
 def scored_dialogues(planner: LocalPlanner, dialogues: list[Example]) -> dict[bool, list[ScoredUtterance]]:
@@ -49,15 +55,15 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
     match, scored as the sequence suite scores them (emopose.bench.sequence_metrics). Fractions."""
     single_hits = single_whole = sequences = exact = anchors = anchor_hits = variant_hits = 0
     for example, scores in zip(examples, scored):
-        acts = planner.best_split(scores)[: planner.max_records]
+        acts = planner.best_split(scores)[: planner.settings.max_records]
         classes = tuple(a.cls for a in acts)
         gold = tuple(a.label for a in example.acts)
         if len(gold) == 1:
             single_hits += classes[0] == gold[0]
             single_whole += len(classes) == 1
             continue
-        item = SequenceItem(example.id, example.text, gold, tuple(example.text[a:b] for a, b in example.anchors),
-                            tuple(example.variants))
+        gold_anchors = tuple(example.text[a:b] for a, b in example.anchors)
+        item = SequenceItem(example.id, example.text, gold, gold_anchors, tuple(example.variants))
         triggers = tuple(example.text[slice(*trigger_span(example.text, scores.analysis, (a.start, a.end)))]
                          for a in acts)
         result = item_scores(item, SequencePrediction(classes, triggers,
@@ -76,56 +82,63 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
 
 @dataclass
 class TrainLocalJob:
-    search: dict[str, list[float]] | None = None  # split parameter -> values to try
-    retrain: bool = False  # train even when a cached artifact matches
+    search: dict[str, list[float]] | None  # split parameter -> values to try
+    retrain: bool  # train even when a cached artifact matches
 
     def __post_init__(self) -> None:
         """Check job.search when the job is built, before the run (and any training) is."""
         search = self.search or {}
         unknown = set(search) - set(SPLIT_PARAMETERS)
         if unknown:
-            raise ValueError(f"job.search: unknown split parameters {sorted(unknown)}; use {SPLIT_PARAMETERS}")
+            raise ValueError(f"job.search: unknown split parameters {sorted(unknown)}; "
+                             f"use {SPLIT_PARAMETERS}")
         not_lists = [name for name, values in search.items()
                      if not isinstance(values, list) or not all(isinstance(v, int | float) for v in values)]
         if not_lists:
             raise ValueError(f"job.search: {not_lists} must each be a list of numbers, "
                              "e.g. job.search={act_cost:[-1.0,-0.5]}")
 
-    def __call__(self, run: Run) -> dict:
-        res = run.resources
-        planner = res.planner
+    def __call__(self, run: Run) -> JobOutput:
+        planner = run.resources.planner
         if not isinstance(planner, LocalPlanner):
             raise ValueError("train_local needs planner=local")
         if self.retrain:
             planner.retrain()
-        held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
-        examples = [e for e in held_out if not e.history]
-        dialogues = [e for e in held_out if e.history]
-        scored = [planner.score(e.text) for e in examples]  # once: every setting re-splits the same scores
-        dialogue_scores = scored_dialogues(planner, dialogues)
-        configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
         search = self.search or {}
         grid = [dict(zip(search, values)) for values in itertools.product(*search.values())]
-        rows = []
-        try:
-            for setting in grid or [{}]:
-                for name, value in {**configured, **setting}.items():
-                    setattr(planner, name, value)
-                rows.append({**configured, **setting, **held_out_metrics(planner, examples, scored),
-                             **context_metrics(planner, dialogues, dialogue_scores)})
-        finally:
-            for name, value in configured.items():
-                setattr(planner, name, value)
-        header = [*SPLIT_PARAMETERS, "single top-1", "kept whole", "sequence exact", "anchor recall",
-                  "exact variant", "dialogue, with history", "without"]
-        metrics = ("single_top1", "single_kept_whole", "sequence_exact", "anchor_recall", "exact_variant",
-                   "context_with_history", "context_without")
-        table = markdown_table(header, [[*(r[p] for p in SPLIT_PARAMETERS),
-                                         *("-" if r[k] is None else f"{100 * r[k]:.1f}%" for k in metrics)]
-                                        for r in rows])
+        rows = held_out_rows(planner, grid or [{}])
         text = (f"Local planner on the held-out training slice ({rows[0]['singles']} single-act, "
-                f"{rows[0]['sequences']} multi-act, {rows[0]['dialogues']} dialogue items)\n\n{table}")
-        results = {"held_out": rows, "training": planner.config.model_dump()}
-        write_results(res.run_dir, results, text)
-        print(text)
-        return results
+                f"{rows[0]['sequences']} multi-act, {rows[0]['dialogues']} dialogue items)\n\n"
+                f"{held_out_table(rows)}")
+        return {"held_out": rows, "training": planner.settings.training.model_dump()}, text
+
+
+def held_out_rows(planner: LocalPlanner, settings: list[dict[str, float]]) -> list[dict]:
+    """The held-out metrics under each setting of the split parameters (the planner's own restored after)."""
+    held_out = held_out_examples(planner)
+    examples = [e for e in held_out if not e.history]
+    dialogues = [e for e in held_out if e.history]
+    scored = [planner.score(e.text) for e in examples]  # once: every setting re-splits the same scores
+    dialogue_scores = scored_dialogues(planner, dialogues)
+    configured = {p: getattr(planner, p) for p in SPLIT_PARAMETERS}
+    rows = []
+    try:
+        for setting in settings:
+            for name, value in {**configured, **setting}.items():
+                setattr(planner, name, value)
+            rows.append({**configured, **setting, **held_out_metrics(planner, examples, scored),
+                         **context_metrics(planner, dialogues, dialogue_scores)})
+    finally:
+        for name, value in configured.items():
+            setattr(planner, name, value)
+    return rows
+
+
+def held_out_table(rows: list[dict]) -> str:
+    header = [*SPLIT_PARAMETERS, "single top-1", "kept whole", "sequence exact", "anchor recall",
+              "exact variant", "dialogue, with history", "without"]
+    metrics = ("single_top1", "single_kept_whole", "sequence_exact", "anchor_recall", "exact_variant",
+               "context_with_history", "context_without")
+    return markdown_table(header, [[*(r[p] for p in SPLIT_PARAMETERS),
+                                    *("-" if r[k] is None else f"{100 * r[k]:.1f}%" for k in metrics)]
+                                   for r in rows])

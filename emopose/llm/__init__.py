@@ -1,1 +1,2 @@
-"""The LLM client shared by chat planners, hosted ASR and TTS: litellm calls, errors, cache, counters, checks, streams."""
+"""The LLM client shared by chat planners, hosted ASR and TTS: litellm calls, errors, cache, counters,
+checks, streams."""

@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
 import tempfile
 import time
 from pathlib import Path
+
+log = logging.getLogger(__name__)
 
 
 def cache_key(payload: dict) -> str:
@@ -40,13 +43,16 @@ class ResponseCache:
         return text if isinstance(text, str) else None
 
     def put(self, key: str, text: str, meta: dict | None = None) -> None:
-        """Write atomically; a failure to cache is never a failure to plan, so errors are swallowed."""
-        path = self._path(key)
+        """Write atomically. A failure to cache is never a failure to plan, but it is logged (a full disk
+        or a read-only cache folder otherwise shows only as runs that never get faster)."""
+        path, tmp = self._path(key), None
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
             fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".json")
             with os.fdopen(fd, "w", encoding="utf-8") as f:
                 json.dump({"text": text, "created": time.time(), **(meta or {})}, f, ensure_ascii=False)
             os.replace(tmp, path)
-        except OSError:
-            pass
+        except OSError as exc:
+            log.warning("LLM cache: could not write %s (%s); the answer is used uncached", path, exc)
+            if tmp is not None:
+                Path(tmp).unlink(missing_ok=True)

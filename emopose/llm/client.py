@@ -24,11 +24,13 @@ NO_KEY_PLACEHOLDER = "no-key-needed"  # the OpenAI SDK refuses a missing key eve
 
 
 def effective_api_key(litellm, model: str, api_base: str | None, api_key: str | None) -> str | None:
-    """For every litellm call: the configured key; else None (litellm reads the provider's env var); a keyless
-    local server (api_base set, no key anywhere) gets a placeholder: the OpenAI SDK refuses to send without one."""
+    """For every litellm call (chat, ASR, TTS): the configured key; else None (litellm reads the provider's
+    env var); a keyless local server (api_base set, no key anywhere) gets a placeholder: the OpenAI SDK
+    refuses to send without one."""
     if api_key or not api_base:
         return api_key
-    return None if litellm.validate_environment(model=model).get("keys_in_environment") else NO_KEY_PLACEHOLDER
+    keys_in_environment = litellm.validate_environment(model=model).get("keys_in_environment")
+    return None if keys_in_environment else NO_KEY_PLACEHOLDER
 
 
 @dataclass(frozen=True)
@@ -42,32 +44,62 @@ class Completion:
 
 
 class LLMClient:
-    """Chat completion with any litellm model string (openai/..., anthropic/..., ollama/..., hosted_vllm/...)."""
+    """Chat completion with any litellm model string (openai/..., anthropic/..., ollama/..., hosted_vllm/...).
 
-    def __init__(self, model: str = "openai/gpt-4o-mini", api_base: str | None = None, api_key: str | None = None,
-                 temperature: float = 0.7, max_tokens: int | None = 1024, timeout_s: float = 60.0,
-                 max_retries: int = 3, backoff_s: float = 1.0, backoff_max_s: float = 30.0, cache: bool = True,
-                 cache_dir: str = "~/.cache/emopose/llm", extra_params: dict | None = None) -> None:
+    Built from the planner's `client:` node (conf/llm/). Besides the call itself it holds what a run needs
+    to know about the endpoint: `concurrency` (requests on the wire at once in a batch), `context_window`
+    (tokens; None: litellm's model info), `probe` (check() sends one real request), `abort_after`
+    (unmendable failures in a row that stop a run) and `pass_index` (the draw while sampling)."""
+
+    def __init__(self, model: str = "openai/gpt-4o-mini", api_base: str | None = None,
+                 api_key: str | None = None, temperature: float = 0.7, max_tokens: int | None = 1024,
+                 timeout_s: float = 60.0, max_retries: int = 3, backoff_s: float = 1.0,
+                 backoff_max_s: float = 30.0, concurrency: int = 16, cache: bool = True,
+                 cache_dir: str = "~/.cache/emopose/llm", pass_index: int = 0,
+                 extra_params: dict | None = None, context_window: int | None = None, probe: bool = True,
+                 abort_after: int = 5) -> None:
         if not isinstance(model, str) or not model.strip():
-            raise LLMConfigError("planner.model is empty; give a litellm model string such as openai/gpt-4o-mini")
+            raise LLMConfigError("planner.client.model is empty; give a litellm model string such as "
+                                 "openai/gpt-4o-mini")
         for key, value, low in (("temperature", temperature, 0), ("timeout_s", timeout_s, 1e-3),
-                                ("max_retries", max_retries, 0), ("backoff_s", backoff_s, 0)):
-            if value < low:
-                raise LLMConfigError(f"planner.{key} = {value} must be >= {low}")
+                                ("max_retries", max_retries, 0), ("backoff_s", backoff_s, 0),
+                                ("concurrency", concurrency, 1), ("abort_after", abort_after, 1),
+                                ("context_window", context_window, 1)):
+            if value is not None and value < low:  # None: litellm's context window
+                raise LLMConfigError(f"planner.client.{key} = {value} must be >= {low}")
         self.model, self.api_base, self.api_key = model, api_base or None, api_key or None
         self.temperature, self.max_tokens, self.timeout_s = float(temperature), max_tokens, float(timeout_s)
-        self.max_retries, self.backoff_s, self.backoff_max_s = int(max_retries), float(backoff_s), float(backoff_max_s)
-        self.extra_params = dict(extra_params or {})
+        self.max_retries, self.backoff_s = int(max_retries), float(backoff_s)
+        self.backoff_max_s, self.extra_params = float(backoff_max_s), dict(extra_params or {})
+        self.concurrency, self.abort_after = int(concurrency), int(abort_after)
+        self.pass_index = int(pass_index)  # a suite job may set it before each pass
+        self.context_window, self.probe = context_window, bool(probe)
         self.cache = ResponseCache(cache_dir) if cache else None
         self.counters = CallCounters()
         self._key_resolved: tuple[str | None] | None = None  # decided on the first call (needs litellm)
         self._repeats: dict[str, int] = {}
         self._repeats_lock = threading.Lock()
+        self._unmendable, self._unmendable_lock = 0, threading.Lock()
 
     @property
     def sampled(self) -> bool:
-        """True when repeated passes are independent draws (temperature > 0; the pass index keys the cache)."""
+        """Repeated passes are independent draws (temperature > 0: the pass index keys the cache)."""
         return self.temperature > 0
+
+    # -- a run's failures in a row ----------------------------------------------------------------
+    def answered(self) -> None:
+        """A request got its answer: the run of unmendable failures is broken."""
+        with self._unmendable_lock:
+            self._unmendable = 0
+
+    def failed_for_good(self, exc: Exception) -> str | None:
+        """Count a request that failed for good; the cause once `abort_after` failures that no retry can
+        mend (refused, 401, 404, overflow) came in a row (the caller then stops its run), else None."""
+        self.counters.add(failed_calls=1)
+        reason = exc.cause if isinstance(exc, LLMCallError) else None
+        with self._unmendable_lock:
+            self._unmendable = self._unmendable + 1 if reason else 0
+            return reason if self._unmendable >= self.abort_after else None
 
     # -- one request -------------------------------------------------------------------------
     def _key(self, messages: list[dict], pass_index: int, response_format: dict | None) -> str:
@@ -108,9 +140,10 @@ class LLMClient:
             self._repeats[key] = repeat + 1
         return cache_key({"draw": key, "repeat": repeat}) if repeat else key
 
-    def _lookup(self, messages: list[dict], pass_index: int,
+    def _lookup(self, messages: list[dict], pass_index: int | None,
                 response_format: dict | None) -> tuple[str | None, Completion | None]:
         self.counters.add(calls=1)
+        pass_index = self.pass_index if pass_index is None else pass_index
         if self.cache is None:
             return None, None
         key = self._draw_key(messages, pass_index, response_format)
@@ -130,19 +163,21 @@ class LLMClient:
         self.counters.add(retries=1)
         return backoff_delay(attempt, self.backoff_s, self.backoff_max_s, exc)
 
-    def _finish(self, key: str | None, response, attempts: int, started: float, queued_s: float = 0.0) -> Completion:
+    def _finish(self, key: str | None, response, attempts: int, started: float,
+                queued_s: float = 0.0) -> Completion:
         latency = time.perf_counter() - started
         self.counters.latency(latency, queued_s)
         choice = response.choices[0]
         text = choice.message.content or ""
-        if self.cache and key and text.strip():  # an empty answer is usually a provider hiccup: ask again next time
+        if self.cache and key and text.strip():  # an empty answer is usually a provider hiccup: ask again
             self.cache.put(key, text, {"model": self.model, "finish_reason": choice.finish_reason})
-        return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason, latency_s=latency,
-                          queued_s=queued_s)
+        return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason,
+                          latency_s=latency, queued_s=queued_s)
 
-    def complete(self, messages: list[dict], pass_index: int = 0,
+    def complete(self, messages: list[dict], pass_index: int | None = None,
                  response_format: dict | None = None) -> Completion:  # type: ignore[return]
-        """The answer to one chat request: from the cache, or from the model with retries."""
+        """The answer to one chat request: from the cache, or from the model with retries (pass_index:
+        the draw while sampling; None: this client's pass_index)."""
         key, hit = self._lookup(messages, pass_index, response_format)
         if hit is not None:
             return hit
@@ -166,7 +201,8 @@ class LLMClient:
             except Exception as exc:  # noqa: BLE001 - as in complete()
                 time.sleep(self._retry_delay(exc, attempt, started))
 
-    async def acomplete(self, messages: list[dict], pass_index: int = 0, gate: asyncio.Semaphore | None = None,
+    async def acomplete(self, messages: list[dict], pass_index: int | None = None,
+                        gate: asyncio.Semaphore | None = None,
                         response_format: dict | None = None) -> Completion:  # type: ignore[return]
         """As complete(); `gate` bounds requests on the wire (a call in backoff frees its slot). Waiting
         for a slot is the batch's queueing, not model latency: it is counted apart (queue_s)."""

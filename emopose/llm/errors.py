@@ -64,14 +64,17 @@ def cause(exc: BaseException, model: str, api_base: str | None) -> str | None:
     detail = str(exc).splitlines()[0][-200:] if str(exc) else type(exc).__name__
     if isinstance(exc, litellm.ContextWindowExceededError):
         return (f"the prompt does not fit {model}'s context window ({detail}); use prompt=compact, lower "
-                "planner.max_tokens, or start the server with a larger context")
+                "planner.client.max_tokens, or start the server with a larger context")
     if unreachable(exc):
-        return f"nothing answers at {where} (connection refused or unknown host): start the server or fix planner.api_base"
+        return (f"nothing answers at {where} (connection refused or unknown host): start the server or fix "
+                "planner.client.api_base")
     status = getattr(exc, "status_code", None)
     if status in (401, 403):
-        return f"{where} rejected the API key (HTTP {status}): set planner.api_key or the provider's env var"
+        return (f"{where} rejected the API key (HTTP {status}): set planner.client.api_key or the provider's "
+                "env var")
     if status == 404:
-        return f"{where} does not know model {model!r} or the path (HTTP 404): check planner.model and planner.api_base"
+        return (f"{where} does not know model {model!r} or the path (HTTP 404): check planner.client.model "
+                "and planner.client.api_base")
     if isinstance(status, int) and 400 <= status < 500 and status not in TRANSIENT_STATUS:
         return f"{where} refused the request (HTTP {status}: {detail})"
     return None

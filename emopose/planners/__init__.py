@@ -1,1 +1,2 @@
-"""Semantic planners, one folder per family (local/, chat/, baselines/); one YAML per option under conf/planner/."""
+"""Semantic planners, one folder per family (local/, chat/, baselines/); one YAML per option
+under conf/planner/."""

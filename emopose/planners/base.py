@@ -53,10 +53,19 @@ class PlannerFailure(RuntimeError):
 
 
 class PlannerMode(StrEnum):
-    """Who writes the words the robot says: the planner (respond) or the caller (narrate: the utterance)."""
+    """Who writes the words the robot says: the planner (respond) or the caller (narrate: the
+    utterance)."""
 
     RESPOND = "respond"
     NARRATE = "narrate"
+
+    @classmethod
+    def parse(cls, value: str) -> PlannerMode:
+        """The mode planner.mode names; a ValueError lists the choices."""
+        try:
+            return cls(value)
+        except ValueError:
+            raise ValueError(f"planner.mode = {value!r}; choose one of {[m.value for m in cls]}") from None
 
 
 @runtime_checkable

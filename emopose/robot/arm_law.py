@@ -33,10 +33,13 @@ class ArmLaw:
         if (self.kp is None) != (self.kd is None):
             raise ValueError(f"arm_law {self.name}: give both kp and kd, or neither (the MJCF's servos)")
         for label, gains in (("kp", self.kp), ("kd", self.kd)):
-            if gains is not None and (np.any(self.gains(gains) < 0) or self.gains(gains).shape != (NUM_JOINTS,)):
-                raise ValueError(f"arm_law {self.name}: {label} must be >= 0, a scalar or {NUM_JOINTS} values")
+            if gains is not None and (np.any(self.gains(gains) < 0)
+                                      or self.gains(gains).shape != (NUM_JOINTS,)):
+                raise ValueError(f"arm_law {self.name}: {label} must be >= 0, "
+                                 f"a scalar or {NUM_JOINTS} values")
         if not 0.0 <= self.tracking_lag_s < 0.5:
-            raise ValueError(f"arm_law {self.name}: tracking_lag_s must be in [0, 0.5) s, got {self.tracking_lag_s}")
+            raise ValueError(f"arm_law {self.name}: tracking_lag_s must be in [0, 0.5) s, "
+                             f"got {self.tracking_lag_s}")
 
     @staticmethod
     def gains(values: float | list[float]) -> np.ndarray:

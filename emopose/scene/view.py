@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from emopose.scene.geometry import Pose2D, map_to_torso
+from emopose.sentences import sentence_span
 
 
 @dataclass(frozen=True)
@@ -68,14 +69,11 @@ def _object(spec) -> SceneObject:
 
 
 def _sentence_around(reply: str, trigger: str | None) -> str:
-    if not trigger or not reply:
-        return ""
-    pos = reply.lower().find(trigger.lower())
+    pos = reply.lower().find(trigger.lower()) if trigger and reply else -1
     if pos < 0:
         return ""
-    start = max(reply.rfind(m, 0, pos) for m in ".!?") + 1
-    ends = [e for e in (reply.find(m, pos) for m in ".!?") if e >= 0]
-    return reply[start:(min(ends) + 1 if ends else len(reply))]
+    start, end = sentence_span(reply, pos)
+    return reply[start:end]
 
 
 @dataclass

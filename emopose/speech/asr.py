@@ -13,6 +13,7 @@ from abc import ABC, abstractmethod
 from pathlib import Path
 
 from emopose.llm.client import effective_api_key
+from emopose.llm.errors import litellm_module
 
 log = logging.getLogger(__name__)
 
@@ -55,8 +56,9 @@ class LitellmTranscriber(Recognizer):
 
     name = "litellm"
 
-    def __init__(self, model: str = "openai/whisper-1", api_base: str | None = None, api_key: str | None = None,
-                 language: str | None = "en", prompt: str | None = None, timeout_s: float = 30.0) -> None:
+    def __init__(self, model: str = "openai/whisper-1", api_base: str | None = None,
+                 api_key: str | None = None, language: str | None = "en", prompt: str | None = None,
+                 timeout_s: float = 30.0) -> None:
         if not model:
             raise ValueError("asr.model is empty: name a litellm transcription model, e.g. openai/whisper-1")
         self.model, self.api_base, self.api_key = model, api_base, api_key
@@ -68,20 +70,20 @@ class LitellmTranscriber(Recognizer):
         if not path.is_file():
             raise ASRError(f"audio file {path} does not exist")
         if path.suffix.lower() not in AUDIO_SUFFIXES:
-            raise ASRError(f"audio file {path} has suffix {path.suffix!r}; use one of {', '.join(AUDIO_SUFFIXES)}")
-        import litellm  # heavy import, only when audio is transcribed
-
+            raise ASRError(f"audio file {path} has suffix {path.suffix!r}; "
+                           f"use one of {', '.join(AUDIO_SUFFIXES)}")
+        litellm = litellm_module()  # heavy import, only when audio is transcribed
         optional = {k: v for k, v in (("language", self.language), ("prompt", self.prompt)) if v}
         started = time.perf_counter()
         try:
+            key = effective_api_key(litellm, self.model, self.api_base, self.api_key)  # a keyless server too
             with path.open("rb") as handle:
                 response = litellm.transcription(model=self.model, file=handle, api_base=self.api_base,
-                                                 api_key=effective_api_key(litellm, self.model, self.api_base,
-                                                                           self.api_key), timeout=self.timeout_s,
-                                                 **optional)
+                                                 api_key=key, timeout=self.timeout_s, **optional)
         except Exception as exc:
-            raise ASRError(f"transcription of {path.name} by {self.model} at {self.api_base or 'provider default'} "
-                           f"failed: {type(exc).__name__}: {str(exc)[:300]} (check asr.model, asr.api_base, "
+            where = self.api_base or "provider default"
+            raise ASRError(f"transcription of {path.name} by {self.model} at {where} failed: "
+                           f"{type(exc).__name__}: {str(exc)[:300]} (check asr.model, asr.api_base, "
                            "asr.api_key)") from exc
         self.last_latency_s = time.perf_counter() - started
         text = (getattr(response, "text", None) or "").strip()

@@ -34,9 +34,11 @@ class EspeakSynthesizer:
     def __init__(self, voice: str = "en-us", rate: int = 165, pitch: int = 50, audio_dir: str | None = None,
                  write_audio: bool = True, library_path: str | None = None) -> None:
         if not RATE_RANGE[0] <= rate <= RATE_RANGE[1]:
-            raise ValueError(f"tts.rate must be {RATE_RANGE[0]}..{RATE_RANGE[1]} words per minute, got {rate}")
+            raise ValueError(f"tts.rate must be {RATE_RANGE[0]}..{RATE_RANGE[1]} words per minute, "
+                             f"got {rate}")
         if not PITCH_RANGE[0] <= pitch <= PITCH_RANGE[1]:
-            raise ValueError(f"tts.pitch must be {PITCH_RANGE[0]}..{PITCH_RANGE[1]} (50 = normal), got {pitch}")
+            raise ValueError(f"tts.pitch must be {PITCH_RANGE[0]}..{PITCH_RANGE[1]} (50 = normal), "
+                             f"got {pitch}")
         self.voice, self.rate, self.pitch = voice, int(rate), int(pitch)
         self.library_path = library_path
         self.write_audio = write_audio

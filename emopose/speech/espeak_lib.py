@@ -45,7 +45,8 @@ class _Event(ctypes.Structure):
                 ("user_data", ctypes.c_void_p), ("id", ctypes.c_void_p)]
 
 
-_Callback = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_short), ctypes.c_int, ctypes.POINTER(_Event))
+_Callback = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.POINTER(ctypes.c_short), ctypes.c_int,
+                             ctypes.POINTER(_Event))
 
 
 @dataclass(frozen=True)
@@ -80,7 +81,8 @@ def _load(library_path: str | None) -> ctypes.CDLL:
             return ctypes.CDLL(name)
         except OSError as exc:
             errors.append(f"{name}: {exc}")
-    raise EspeakUnavailable(f"libespeak-ng could not be loaded ({'; '.join(errors) or 'not found'}): {INSTALL_HINT}")
+    raise EspeakUnavailable(f"libespeak-ng could not be loaded ({'; '.join(errors) or 'not found'}): "
+                            f"{INSTALL_HINT}")
 
 
 class _Engine:
@@ -109,7 +111,8 @@ class _Engine:
         while events[i].type != EVENT_LIST_TERMINATED:
             event = events[i]
             if event.type == EVENT_WORD:
-                self._events.append(WordEvent(event.text_position - 1, event.length, event.audio_position / 1e3))
+                self._events.append(WordEvent(event.text_position - 1, event.length,
+                                              event.audio_position / 1e3))
             i += 1
         return 0  # continue synthesis
 

@@ -15,6 +15,7 @@ import re
 from pathlib import Path
 
 from emopose.llm.client import effective_api_key
+from emopose.llm.errors import litellm_module
 from emopose.speech.clip import SpeechClip, WordTiming
 from emopose.speech.espeak import EspeakSynthesizer
 from emopose.speech.espeak_lib import EspeakUnavailable
@@ -26,9 +27,9 @@ log = logging.getLogger(__name__)
 class LitellmSpeech:
     name = "litellm"
 
-    def __init__(self, model: str = "openai/gpt-4o-mini-tts", voice: str = "alloy", api_base: str | None = None,
-                 api_key: str | None = None, timeout_s: float = 30.0, audio_dir: str | None = None,
-                 fallback: dict | None = None) -> None:
+    def __init__(self, model: str = "openai/gpt-4o-mini-tts", voice: str = "alloy",
+                 api_base: str | None = None, api_key: str | None = None, timeout_s: float = 30.0,
+                 audio_dir: str | None = None, fallback: dict | None = None) -> None:
         if not model:
             raise ValueError("tts.model is empty: name a litellm speech model, e.g. openai/gpt-4o-mini-tts")
         self.model, self.voice, self.api_base, self.api_key = model, voice, api_base, api_key
@@ -45,7 +46,9 @@ class LitellmSpeech:
         except Exception as exc:  # any hosted failure: speak locally rather than lose the turn's speech
             local = self._espeak()
             if local is None:
-                raise RuntimeError(f"hosted TTS {self.model} failed ({exc}) and espeak-ng is not available") from exc
+                raise RuntimeError(
+                    f"hosted TTS {self.model} failed ({exc}) and espeak-ng is not available"
+                ) from exc
             log.warning("hosted TTS %s failed (%s: %s); falling back to espeak", self.model,
                         type(exc).__name__, str(exc)[:200])
             return local.synthesize(text)
@@ -53,9 +56,8 @@ class LitellmSpeech:
                           audio_path=path, estimated=True)
 
     def _hosted(self, text: str) -> tuple[Path, float]:
-        import litellm  # heavy import, only when hosted speech is used
-
-        key = effective_api_key(litellm, self.model, self.api_base, self.api_key)  # a keyless local server too
+        litellm = litellm_module()  # heavy import, only when hosted speech is used
+        key = effective_api_key(litellm, self.model, self.api_base, self.api_key)  # a keyless server too
         response = litellm.speech(model=self.model, input=text, voice=self.voice, api_base=self.api_base,
                                   api_key=key, response_format="wav", timeout=self.timeout_s)
         audio = response.content

@@ -5,7 +5,7 @@ importable and lists an output, else `paplay` with a running sound server, else 
 card), otherwise a timed null sink; player=none is always the null sink. play() never blocks and
 never raises: gestures are released against the returned start, so a device that cannot be started
 (or exits with an error) is logged and replaced by the null sink, and the gesture timeline runs on.
-The null sink "plays" for clip.duration_s from the returned start. Under a FakeClock (offline
+The null sink "plays" for clip.duration_s from the returned start. On a virtual clock (offline
 rendering, evaluations) the null sink is used whatever the sink setting: a real device cannot follow
 virtual time. The returned start is launch time + latency_s (device output latency, measured per
 device; sounddevice reports its own). play(..., follow=True) queues a streamed reply's next sentence:
@@ -21,7 +21,7 @@ import subprocess
 import threading
 from pathlib import Path
 
-from emopose.clock import Clock, FakeClock
+from emopose.clock import Clock
 from emopose.speech.clip import SpeechClip
 
 log = logging.getLogger(__name__)
@@ -77,10 +77,11 @@ class Player:
 
     # -- device --------------------------------------------------------------------------------
     def _silent(self, clip: SpeechClip, clock: Clock) -> bool:
-        return self.sink == "none" or isinstance(clock, FakeClock) or clip.audio_path is None or clip.duration_s <= 0
+        return self.sink == "none" or not clock.realtime or clip.audio_path is None or clip.duration_s <= 0
 
     def _follow(self, clip: SpeechClip, clock: Clock, at: float) -> float:
-        """Start the clip at `at` (heard then: launched one device latency earlier), unless stop() comes first."""
+        """Start the clip at `at` (heard then: launched one device latency earlier), unless stop() comes
+        first."""
         if self._silent(clip, clock) or not self._probe():
             return at  # the null sink just plays on
         with self._lock:
@@ -125,7 +126,8 @@ class Player:
         _, err = process.communicate()
         if process.returncode != 0 and not getattr(process, "stopped_by_us", False):
             log.warning("audio player %s exited with %s (%s); using the null sink from now on",
-                        process.args[0], process.returncode, (err or b"").decode(errors="replace").strip()[:200])
+                        process.args[0], process.returncode,
+                        (err or b"").decode(errors="replace").strip()[:200])
             self._device = False
 
     def _probe(self):

@@ -18,7 +18,9 @@ def cache_dir(configured: str | Path | None, key: str) -> Path:
     try:
         path.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ValueError(f"{key} = {str(path)!r} cannot be created ({exc}); point it at a writable folder") from exc
+        raise ValueError(
+            f"{key} = {str(path)!r} cannot be created ({exc}); point it at a writable folder"
+        ) from exc
     return path
 
 

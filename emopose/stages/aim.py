@@ -1,7 +1,7 @@
 """Aim stage (conf/pipeline/tour.yaml): retarget pointing gestures at the object they refer to.
 
 Runs after modulate and rewrites `modulated` (the pipeline lets a later stage replace a field).
-For each pointing record whose target the scene knows (its SceneSlot, see scene_view.py), the gesture
+For each pointing record whose target the scene knows (its SceneSlot, emopose/scene/view.py), the gesture
 is mirrored onto the arm on the target's side when needed, and every "peak" keyframe (an interior
 keyframe whose arm excursion reaches `peak_fraction` of the largest) is replaced by an IK solution
 that aims the hand's pointing axis at the target. The approach and return keyframes stay the
@@ -20,11 +20,12 @@ from itertools import pairwise
 
 import numpy as np
 
-from emopose.library import JointLimits
+from emopose.joint_limits import JointLimits
 from emopose.robot.g1_spec import ARM_DOF
 from emopose.robot.kinematics import mirror
 from emopose.robot.pointing_ik import aim_arm
 from emopose.scene.view import SceneSlot
+from emopose.stages.modulate import LIMIT_MARGIN
 from emopose.turn.model import ModulatedGesture, Turn
 
 log = logging.getLogger(__name__)
@@ -75,7 +76,7 @@ class AimStage:
     skip: tuple[str, ...] = ("point_to_self",)  # deictic to the robot itself: never aimed elsewhere
     peak_fraction: float = 0.6
     side_switch_m: float = 0.15  # mirror onto the other arm when the target is this far to its side
-    margin: float = 0.02  # stay this far inside the joint limits (as modulate does)
+    margin: float = LIMIT_MARGIN  # stay this far inside the joint limits, as modulate does
     tolerance_deg: float = 0.3
     abductions: tuple[float, ...] = (0.0, 0.3, 0.6)  # rad of extra shoulder roll to retry with on a collision
     name = "aim"
@@ -120,7 +121,8 @@ class AimStage:
             if not reason:
                 break
         if reason:
-            log.warning("aim: %s at %s collides (%s); keeping the library motion", gesture, target_name, reason)
+            log.warning("aim: %s at %s collides (%s); keeping the library motion",
+                        gesture, target_name, reason)
         report = AimReport(gesture, target_name, ("left", "right")[wanted], mirrored, max(errors), converged,
                            applied=not reason, reason=reason or "")
         return aimed, report

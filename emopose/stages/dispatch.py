@@ -12,7 +12,7 @@ fake clock, or real time with the monotonic clock).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from emopose.execution.control_loop import ControlLoop
 from emopose.execution.sequencer import State
@@ -40,6 +40,15 @@ class Dispatch:
         if self.until not in UNTIL:
             raise ValueError(f"pipeline.dispatch.until must be one of {UNTIL}, got {self.until!r}")
 
+    def waiting_until(self, until: str) -> Dispatch:
+        """A copy that waits `until` (one of UNTIL) after dispatching."""
+        return replace(self, until=until)
+
+    def streamed(self, follow: bool) -> Dispatch:
+        """A copy for one sentence of a streamed reply: it returns at once (the runner waits after the
+        last sentence); with `follow` its audio follows the clip playing instead of cutting it."""
+        return replace(self, until="none", follow=follow)
+
     def __call__(self, turn: Turn) -> DispatchReport:
         sequencer = self.loop.sequencer
         first_event, ticks = sequencer.events.total, self.loop.stats.ticks
@@ -62,4 +71,5 @@ class Dispatch:
             return True
         if self.until == "settle":
             return self.loop.wait_until(sequencer.settled, self.timeout_s)
-        return self.loop.wait_until(lambda: sequencer.settled() and sequencer.state == State.IDLE, self.timeout_s)
+        return self.loop.wait_until(lambda: sequencer.settled() and sequencer.state == State.IDLE,
+                                    self.timeout_s)

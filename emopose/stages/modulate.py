@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from emopose.library import JointLimits
+from emopose.joint_limits import JointLimits
 from emopose.turn.model import ModulatedGesture, ResolvedGesture, Turn
 
 INTENSITY_GAINS = (0.4, 0.6, 1.0, 1.3, 1.6)
@@ -20,7 +20,8 @@ LIMIT_MARGIN = 0.02
 
 
 def modulate_keyframes(q: np.ndarray, intensity: int, limits: JointLimits,
-                       gains: tuple[float, ...] = INTENSITY_GAINS, margin: float = LIMIT_MARGIN) -> np.ndarray:
+                       gains: tuple[float, ...] = INTENSITY_GAINS,
+                       margin: float = LIMIT_MARGIN) -> np.ndarray:
     """Apply Eq. intensity to (K, 14) keyframes; returns a new array (level 3 returns an exact copy)."""
     out = np.array(q, dtype=float)
     if intensity == 3 or len(out) < 3:

@@ -16,7 +16,7 @@ import re
 from typing import Any
 
 from emopose import CLASSES
-from emopose.contract import GestureRecord, Plan
+from emopose.contract import MAX_REPLY_CHARS, GestureRecord, Plan
 from emopose.planners.base import PlannerOutput
 from emopose.planners.baselines.keyword import keyword_records
 from emopose.turn.model import Turn
@@ -63,7 +63,7 @@ def _text(value: Any) -> str | None:
     if not isinstance(value, (str, int, float)):
         raise PlanValueError(f"expected text, got {type(value).__name__}")
     text = str(value).strip()
-    return text[:200] or None
+    return text[:MAX_REPLY_CHARS] or None
 
 
 def _record(raw: Any) -> tuple[GestureRecord, str | None]:
@@ -120,15 +120,16 @@ def parse_plan(raw: str | None, utterance: str = "", line: str | None = None) ->
                     notes=("empty model output; one neutral record",))
     candidate = _json_candidate(text)
     if candidate is None:
-        return Plan(reply=line or text.strip()[:2000], records=(GestureRecord(cls="neutral"),), source="plain_text",
-                    notes=("plain-text answer; one neutral record",))
+        return Plan(reply=line or text.strip()[:2000], records=(GestureRecord(cls="neutral"),),
+                    source="plain_text", notes=("plain-text answer; one neutral record",))
     try:
         return _plan_from_json(json.loads(candidate), utterance)
     except (json.JSONDecodeError, PlanValueError, RecursionError, ValueError) as exc:
         log.warning("model output unusable (%s); keyword fallback", str(exc)[:200])
         source_text = line or utterance or text
-        return Plan(reply=line or utterance or text.strip()[:2000], records=tuple(keyword_records(source_text)),
-                    source="keyword_fallback", notes=(f"keyword fallback: {str(exc)[:200]}",))
+        return Plan(reply=line or utterance or text.strip()[:2000],
+                    records=tuple(keyword_records(source_text)), source="keyword_fallback",
+                    notes=(f"keyword fallback: {str(exc)[:200]}",))
 
 
 def parse_output(output: PlannerOutput, utterance: str = "") -> Plan:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -24,7 +24,7 @@ import numpy as np
 from emopose.contract import trigger_position
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.trajectory import TrajectoryBuilder
-from emopose.library import JointLimits
+from emopose.joint_limits import JointLimits
 from emopose.speech.clip import SpeechClip, Synthesizer
 from emopose.turn.model import Release, ReleaseRule, Schedule, Turn
 from emopose.turn.timeline import TimelinePlanner, TimelineSettings
@@ -33,7 +33,8 @@ MODES = ("anchor", "words", "timeline")
 
 log = logging.getLogger(__name__)
 
-def anchor_release_times(reply: str, triggers: list[str | None], duration_s: float) -> list[tuple[float, ReleaseRule]]:
+def anchor_release_times(reply: str, triggers: list[str | None],
+                         duration_s: float) -> list[tuple[float, ReleaseRule]]:
     """The paper's schedule equation with its interpolation and even-spacing rules."""
     count = len(triggers)
     length = max(len(reply), 1)
@@ -59,7 +60,8 @@ def anchor_release_times(reply: str, triggers: list[str | None], duration_s: flo
     return out
 
 
-def word_release_times(reply: str, triggers: list[str | None], speech: SpeechClip) -> list[tuple[float, ReleaseRule]]:
+def word_release_times(reply: str, triggers: list[str | None],
+                       speech: SpeechClip) -> list[tuple[float, ReleaseRule]]:
     """True word onsets where the trigger is found and the synthesizer gave word timings."""
     out = anchor_release_times(reply, triggers, speech.duration_s)
     for k, trigger in enumerate(triggers):
@@ -91,6 +93,16 @@ class ScheduleStage:
         if self.mode not in MODES:
             raise ValueError(f"pipeline.schedule.mode must be one of {MODES}, got {self.mode!r}")
         self._planner = TimelinePlanner(TrajectoryBuilder(self.limits), self.timeline, self.safety)
+
+    def in_mode(self, mode: str) -> ScheduleStage:
+        """A copy that schedules in `mode` (sync_eval measures every mode with one configuration)."""
+        return replace(self, mode=mode)
+
+    def with_preroll_at_most(self, preroll_s: float) -> ScheduleStage:
+        """This stage with the timeline's pre-roll bounded by `preroll_s` (itself when already within)."""
+        if self.timeline.max_preroll_s <= preroll_s:
+            return self
+        return replace(self, timeline=replace(self.timeline, max_preroll_s=preroll_s))
 
     def __call__(self, turn: Turn) -> tuple[SpeechClip, Schedule]:
         reply = turn.plan.reply

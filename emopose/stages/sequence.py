@@ -14,7 +14,7 @@ to the sequencer as "dropped" events and never queued.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from emopose.clock import Clock
 from emopose.execution.gesture_command import GestureCommand
@@ -35,6 +35,10 @@ class SequenceStage:
     name = "sequence"
     reads = ("speech", "schedule")
     writes = ("submitted",)
+
+    def queueing(self) -> SequenceStage:
+        """A copy that queues behind the gestures already handed over instead of interrupting them."""
+        return replace(self, interrupt=False)
 
     def __call__(self, turn: Turn) -> Submission:
         schedule = turn.schedule
@@ -61,11 +65,13 @@ class SequenceStage:
 
     @staticmethod
     def _command(k: int, gesture: ModulatedGesture, release: Release, speech_start: float) -> GestureCommand:
-        common = dict(name=gesture.name, duration=gesture.duration, release_at=speech_start + release.release_s,
-                      label=gesture.resolved.record.cls, record=k)
+        common = dict(name=gesture.name, duration=gesture.duration,
+                      release_at=speech_start + release.release_s, label=gesture.resolved.record.cls,
+                      record=k)
         timing = release.timing
         if timing is None:
-            return GestureCommand(keyframes=gesture.keyframes, stroke=gesture.resolved.entry.stroke_span, **common)
+            return GestureCommand(keyframes=gesture.keyframes, stroke=gesture.resolved.entry.stroke_span,
+                                  **common)
         offsets = tuple(t - timing.times[0] for t in timing.times)
         return GestureCommand(keyframes=timing.keyframes, stroke=timing.stroke, offsets=offsets,
                               blend_in=timing.blend_in, cut=timing.cut, **common)

@@ -48,7 +48,8 @@ class DraftReport:
     explicit_duration: bool
     keyframes: np.ndarray  # (K, 14) after Eq. intensity
     trajectory: Trajectory  # (N + 1, 14) at 50 Hz from the neutral pose
-    keyframe_violations: list[str]  # joints outside the library's limits (+ margin): the library refuses these
+    # joints outside the library's limits (+ margin): the library refuses these
+    keyframe_violations: list[str]
     trajectory_violations: list[str]
     levels: list[LevelCheck]
 
@@ -93,7 +94,8 @@ class PoseStudio:
         try:
             return LibraryEntry.model_validate(raw)
         except ValidationError as exc:
-            problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'draft'}: {e['msg']}" for e in exc.errors())
+            problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'draft'}: {e['msg']}"
+                                 for e in exc.errors())
             raise DraftError(problems) from exc
 
     def report(self, entry: LibraryEntry, intensity: int = NOMINAL_LEVEL) -> DraftReport:
@@ -119,4 +121,5 @@ class PoseStudio:
         # The sequencer's hook is the authority (it carries the configured clearance); without one
         # (safety=off) the default checker still informs the author.
         reason = self.safety(trajectory.samples) if self.safety is not None else collision.reason
-        return LevelCheck(level, reason is None, reason, float(collision.min_clearance_m), float(trajectory.stretch))
+        return LevelCheck(level, reason is None, reason, float(collision.min_clearance_m),
+                          float(trajectory.stretch))

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from emopose.contract import LibraryEntry
-from emopose.library import LibraryError, MotionLibrary
+from emopose.joint_limits import LibraryError
+from emopose.library import MotionLibrary
 from emopose.studio.authoring import PoseStudio
 
 NAME_PATTERN = r"^[a-z][a-z0-9_]{1,63}$"
@@ -78,4 +79,5 @@ def save_motion(studio: PoseStudio, raw: dict, overwrite: bool = False) -> SaveR
         saved = library.save(raw)
     except LibraryError as exc:
         raise SaveRefused(str(exc)) from exc
-    return SaveResult(saved, target, backup if backup and backup.exists() else None, library.version, replaced)
+    return SaveResult(saved, target, backup if backup and backup.exists() else None, library.version,
+                      replaced)

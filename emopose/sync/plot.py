@@ -5,6 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from emopose.contract import EventKind
+from emopose.sync.strokes import ENDS
+
 
 def plot_timelines(path: Path, item, turn, strokes) -> None:
     import matplotlib
@@ -15,7 +18,7 @@ def plot_timelines(path: Path, item, turn, strokes) -> None:
     speech_start = turn.dispatched.speech_start
     spans = {}
     for e in turn.dispatched.events:
-        if e.command_id is not None and e.kind in ("started", "completed", "cut", "stopped"):
+        if e.command_id is not None and e.kind in (EventKind.STARTED, *ENDS):
             spans.setdefault(e.command_id, []).append(e.t - speech_start)
     by_record = {c.record: c for c in turn.submitted.commands}
     fig, ax = plt.subplots(figsize=(10, 1.2 + 0.45 * len(strokes)))
@@ -31,7 +34,8 @@ def plot_timelines(path: Path, item, turn, strokes) -> None:
         if row.onset_s is not None:
             ax.plot(row.onset_s, y, "k|", ms=16, mew=2, label="trigger onset" if row.k == 0 else None)
         if row.planned_s is not None:
-            ax.plot(row.planned_s, y, "o", mfc="none", color="tab:orange", label="planned stroke" if row.k == 0 else None)
+            ax.plot(row.planned_s, y, "o", mfc="none", color="tab:orange",
+                    label="planned stroke" if row.k == 0 else None)
         if row.executed_s is not None:
             ax.plot(row.executed_s, y, "x", color="tab:red", label="executed stroke" if row.k == 0 else None)
         label = f"{row.motion}" + (" (dropped)" if row.dropped else "")

@@ -40,8 +40,8 @@ def speech_timeline(turn, speech_start: float) -> dict:
                          "onset_s": None if position is None else speech.onset_at_char(position)})
     return {"speech_start": speech_start, "duration_s": speech.duration_s,
             "text": speech.text, "preroll_s": turn.schedule.preroll_s,
-            "words": [{"text": w.text, "char_start": w.char_start, "char_end": w.char_end, "start_s": w.start_s}
-                      for w in speech.words],
+            "words": [{"text": w.text, "char_start": w.char_start, "char_end": w.char_end,
+                       "start_s": w.start_s} for w in speech.words],
             "gestures": gestures}
 
 
@@ -57,8 +57,8 @@ def read_stroke_sync(path: str | Path, tolerance: float = STROKE_TOLERANCE) -> l
     events = [(m["t"], m["kind"], m["command_id"]) for _, m in topics.get(EVENTS, [])]
     rows = []
     for number, (_, turn) in enumerate(topics[TIMELINE]):
-        planned = [PlannedStroke(g["k"], g["motion"], g["command_id"], np.asarray(g["keyframe"]), g["planned_s"],
-                                 g["dropped"]) for g in turn["gestures"]]
+        planned = [PlannedStroke(g["k"], g["motion"], g["command_id"], np.asarray(g["keyframe"]),
+                                 g["planned_s"], g["dropped"]) for g in turn["gestures"]]
         streams = Streams(events, turn["speech_start"], times, q,
                           None if sim is None else np.array([m["t"] for _, m in sim]),
                           None if sim is None else np.array([m["q"] for _, m in sim]))

@@ -15,10 +15,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from emopose import STROKE_TOLERANCE
+from emopose.contract import EventKind
 
 WINDOW_S = (-0.2, 0.1)  # a stroke belongs to its word when it lands 200 ms before to 100 ms after the onset
 EDGE_MS = 1e-3  # stream times carry ~1e-12 s of float noise: a stroke on a window edge is inside it
-ENDS = ("completed", "cut", "stopped")
+ENDS = (EventKind.COMPLETED, EventKind.CUT, EventKind.STOPPED)
 
 
 @dataclass(frozen=True)
@@ -89,7 +90,7 @@ class Streams:
 
 def measure_strokes(item: str, planned: list[PlannedStroke], onsets: list[float | None], streams: Streams,
                     preroll_s: float, tolerance: float = STROKE_TOLERANCE) -> list[StrokeSync]:
-    started = {cid: t for t, kind, cid in streams.events if kind == "started"}
+    started = {cid: t for t, kind, cid in streams.events if kind == EventKind.STARTED}
     ended = {cid: t for t, kind, cid in streams.events if kind in ENDS}
     rows = []
     for p in planned:
@@ -97,10 +98,12 @@ def measure_strokes(item: str, planned: list[PlannedStroke], onsets: list[float 
         if p.command_id in started:
             start = started[p.command_id]
             end = ended.get(p.command_id, float(streams.command_times[-1]))
-            executed = first_arrival(streams.command_times, streams.commands, p.keyframe, start, end, tolerance)
+            executed = first_arrival(streams.command_times, streams.commands, p.keyframe, start, end,
+                                     tolerance)
             if streams.states is not None:
                 dt = float(streams.state_times[0] - streams.command_times[0])
-                simulated = first_arrival(streams.state_times, streams.states, p.keyframe, start, end + dt, tolerance)
+                simulated = first_arrival(streams.state_times, streams.states, p.keyframe, start, end + dt,
+                                          tolerance)
         speech = streams.speech_start
         rows.append(StrokeSync(item, p.k, p.motion, onsets[p.k], p.planned_s,
                                None if executed is None else executed - speech,

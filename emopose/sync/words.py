@@ -11,58 +11,21 @@ aims at, so "scheduled vs center" separates its character-for-time error from it
 
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass
-from pathlib import Path
 
 import numpy as np
 
-from emopose import CLASSES, CONTROL_DT
-from emopose.contract import GestureRecord, Plan, trigger_position
+from emopose import CONTROL_DT
+from emopose.bench.suites import SequenceItem
+from emopose.contract import EventKind, trigger_position
 from emopose.speech.word_events import clean_events, onset_of_span
 
 
-@dataclass(frozen=True)
-class SuiteItem:
-    id: str
-    text: str
-    labels: tuple[str, ...]
-    anchors: tuple[str, ...]
-    variants: tuple[str | None, ...]
-
-    def plan(self) -> Plan:
-        """The annotation as the planner's answer: the reply is the text, one record per label."""
-        records = tuple(GestureRecord(cls=c, variant=v, trigger=a) for c, a, v in
-                        zip(self.labels, self.anchors, self.variants))
-        return Plan(reply=self.text, records=records, source="scripted", notes=("sync_eval annotation",))
-
-
-def load_suite(path: Path, limit: int | None = None) -> list[SuiteItem]:
-    items = []
-    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
-        if not line.strip():
-            continue
-        where = f"{path}:{number}"
-        try:
-            raw = json.loads(line)
-            labels, anchors = tuple(raw["labels"]), tuple(raw["anchors"])
-            variants = tuple(raw.get("variants") or [None] * len(labels))
-            item = SuiteItem(str(raw["id"]), str(raw["text"]), labels, anchors, variants)
-        except (ValueError, KeyError, TypeError) as exc:
-            raise ValueError(f"{where}: need id, text, labels, anchors, variants ({exc!r})") from exc
-        if not len(labels) == len(anchors) == len(variants) or not labels:
-            raise ValueError(f"{where}: labels, anchors and variants must be non-empty and of equal length")
-        unknown = [c for c in labels if c not in CLASSES]
-        if unknown:
-            raise ValueError(f"{where}: unknown labels {unknown}; allowed: {', '.join(CLASSES)}")
-        items.append(item)
-        if limit is not None and len(items) >= limit:
-            break
-    return items
-
-
 def annotated_spans(text: str, anchors: tuple[str, ...]) -> list[tuple[int, int] | None]:
-    """Each anchor's occurrence, searched in order after the previous one (first occurrence as fallback)."""
+    """Each anchor's occurrence, searched in order after the previous one (first occurrence as fallback).
+
+    Unlike the suite loader's exact check (emopose.bench.suites.anchor_spans) this is case-insensitive
+    and keeps a missing anchor as None: the say-do check reports it instead of refusing the item."""
     spans: list[tuple[int, int] | None] = []
     cursor, lowered = 0, text.lower()
     for anchor in anchors:
@@ -100,9 +63,9 @@ class GestureSync:
         return asdict(self)
 
 
-def measure_turn(item: SuiteItem, turn, events) -> list[GestureSync]:
+def measure_turn(item: SequenceItem, turn, events) -> list[GestureSync]:
     schedule, submitted, dispatched = turn.schedule, turn.submitted, turn.dispatched
-    started = {e.command_id: e.t for e in dispatched.events if e.kind == "started"}
+    started = {e.command_id: e.t for e in dispatched.events if e.kind == EventKind.STARTED}
     spans = annotated_spans(item.text, item.anchors)
     kept = clean_events(item.text, events)
     rows = []
@@ -117,8 +80,8 @@ def measure_turn(item: SuiteItem, turn, events) -> list[GestureSync]:
                   if command is not None and command.id in started else None)
         queued = actual is not None and actual - release.release_s > CONTROL_DT + 1e-9
         first = span is not None and trigger_position(item.text, trigger) == span[0]
-        rows.append(GestureSync(item.id, k, gesture.name, trigger, release.trigger_found, first, release.how,
-                                release.release_s, onset, center, actual, queued))
+        rows.append(GestureSync(item.id, k, gesture.name, trigger, release.trigger_found, first,
+                                release.how, release.release_s, onset, center, actual, queued))
     return rows
 
 
@@ -127,8 +90,9 @@ def offset_stats(offsets_s: list[float]) -> dict:
     if not offsets_s:
         return {"n": 0, "mean_abs_ms": None, "p95_abs_ms": None, "max_abs_ms": None, "mean_signed_ms": None}
     x = np.asarray(offsets_s) * 1e3
-    return {"n": int(x.size), "mean_abs_ms": float(np.abs(x).mean()), "p95_abs_ms": float(np.percentile(np.abs(x), 95)),
-            "max_abs_ms": float(np.abs(x).max()), "mean_signed_ms": float(x.mean())}
+    return {"n": int(x.size), "mean_abs_ms": float(np.abs(x).mean()),
+            "p95_abs_ms": float(np.percentile(np.abs(x), 95)), "max_abs_ms": float(np.abs(x).max()),
+            "mean_signed_ms": float(x.mean())}
 
 
 def summarize(rows: list[GestureSync]) -> dict:
@@ -141,7 +105,8 @@ def summarize(rows: list[GestureSync]) -> dict:
     return {
         "gestures": len(rows), "measured": len(measured), "missing_trigger": sum(not r.found for r in rows),
         "not_started": sum(r.actual_s is None for r in rows), "release_how": hows,
-        "first_occurrence_mismatch": sum(r.found and r.onset_s is not None and not r.first_occurrence for r in rows),
+        "first_occurrence_mismatch": sum(r.found and r.onset_s is not None and not r.first_occurrence
+                                         for r in rows),
         "scheduled_vs_onset": offset_stats([r.scheduled_s - r.onset_s for r in measured]),
         "scheduled_vs_center": offset_stats([r.scheduled_s - r.center_s for r in measured]),
         "actual_vs_onset": offset_stats([r.actual_s - r.onset_s for r in ran]),

@@ -25,6 +25,7 @@ from emopose.backends.g1.constants import (
     response_topic,
 )
 from emopose.backends.g1.dds import DdsSession
+from emopose.execution.worker import Worker
 
 
 class FakeLoco:
@@ -44,15 +45,13 @@ class FakeLoco:
         self.odom = [0.0, 0.0, 0.0]
         self._velocity = (0.0, 0.0, 0.0)
         self._remaining_s = 0.0
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._serve, name="fake-loco", daemon=True)
+        self._worker = Worker("fake-loco", self._serve, join_timeout_s=1.0)
 
     def start(self) -> None:
-        self._thread.start()
+        self._worker.start()
 
     def stop(self) -> None:
-        self._stop.set()
-        self._thread.join(timeout=1.0)
+        self._worker.stop()
 
     def step(self, dt: float) -> None:
         """Integrate odometry over dt (called from the robot's state loop)."""
@@ -69,8 +68,8 @@ class FakeLoco:
                 yaw + omega * dt,
             ]
 
-    def _serve(self) -> None:
-        while not self._stop.is_set():
+    def _serve(self, stop: threading.Event) -> None:
+        while not stop.is_set():
             try:
                 requests = self._requests.take_typed(timeout_s=0.05)
             except Exception:  # noqa: BLE001 - the session was closed under us: just stop

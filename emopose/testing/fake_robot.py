@@ -27,6 +27,7 @@ from emopose.backends.g1.arm_command import decode_arm_command
 from emopose.backends.g1.constants import LOCO_SERVICE, TOPIC_ARM_SDK, TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession, queue_qos
 from emopose.backends.g1.hg_types import LowCmd_, LowState_
+from emopose.execution.worker import Worker
 from emopose.robot.g1_spec import NUM_MOTORS, WEIGHT_MOTOR
 from emopose.testing.fake_loco import FakeLoco
 
@@ -58,6 +59,7 @@ class FakeG1:
         self._cmd_lock = threading.Lock()
         self.good = self.bad_crc = self.undecodable = 0
         self._stop = threading.Event()
+        self._commands = Worker("fake-arm-sdk", self._take_commands, join_timeout_s=1.0)
         self._record = wire.new_lowstate()
         self._record["version"] = (1, 0)
         self._record["imu_state"]["quaternion"] = (1.0, 0.0, 0.0, 0.0)
@@ -69,8 +71,8 @@ class FakeG1:
                 self._log_file.write(json.dumps(entry) + "\n")
 
     # -- rt/arm_sdk --------------------------------------------------------------------
-    def _take_commands(self) -> None:
-        while not self._stop.is_set():
+    def _take_commands(self, stop: threading.Event) -> None:
+        while not stop.is_set():
             try:
                 samples = self._cmd_reader.take_stamped(timeout_s=0.05)
             except Exception:  # noqa: BLE001 - the session was closed under us: just stop
@@ -118,7 +120,7 @@ class FakeG1:
         self._state_writer.write(wire.lowstate_to_cdr(self._record))
 
     def run(self) -> None:
-        threading.Thread(target=self._take_commands, name="fake-arm-sdk", daemon=True).start()
+        self._commands.start()
         self.loco.start()
         period = 1.0 / self.args.lowstate_hz
         start = last = time.monotonic()
@@ -144,6 +146,7 @@ class FakeG1:
 
     def close(self) -> None:
         self._stop.set()
+        self._commands.stop()
         self.loco.stop()
         self.log(
             {

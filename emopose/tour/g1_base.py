@@ -1,4 +1,5 @@
-"""The real G1's base as a MobileBase: velocity through the loco RPC, pose from onboard odometry.
+"""The real G1's base as a MobileBase: velocity through the loco RPC, pose from onboard odometry;
+G1TourBase opens it for the tour (tour/base=g1).
 
 Commands go out through emopose.backends.g1.LocoClient.set_velocity (it clamps to vx <= 0.3 m/s)
 at most every `period_s`, each with a short `duration`, so the robot stops by itself within that
@@ -12,8 +13,17 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
+from emopose.backends.base import Backend
 from emopose.scene.geometry import Pose2D, wrap_angle
+from emopose.tour.scenario import TourConfigError, TourSpec
+
+if TYPE_CHECKING:
+    from emopose.backends.g1.loco import LocoClient
+
+# (loco client, backend) -> a callable returning the robot's odometry pose on its own frame
+OdometryFactory = Callable[["LocoClient", Backend], Callable[[], Pose2D]]
 
 
 class G1Base:
@@ -62,3 +72,30 @@ class G1Base:
 
     def after_tick(self, dt: float) -> None:
         pass  # the robot integrates its own odometry
+
+
+class G1TourBase:
+    """tour/base=g1: the loco client on the backend's DDS domain and interface, walking on onboard odometry
+    within the scenario's speed limits. close() closes the client (the runner has stopped the base)."""
+
+    def __init__(self, domain_id: int, network_interface: str | None,
+                 odometry: OdometryFactory | None = None) -> None:
+        self.domain_id, self.network_interface, self.odometry = domain_id, network_interface, odometry
+        self._loco: LocoClient | None = None
+
+    def open(self, backend: Backend, spec: TourSpec) -> G1Base:
+        if self.odometry is None:
+            raise TourConfigError("the tour on the G1 walks on onboard odometry: set job.base.odometry to "
+                                  "a factory (loco, backend) -> callable returning a "
+                                  "emopose.scene.geometry.Pose2D "
+                                  "({_target_: module.factory, _partial_: true})")
+        from emopose.backends.g1 import LocoClient  # imports cyclonedds
+
+        self._loco = LocoClient(domain_id=self.domain_id, network_interface=self.network_interface,
+                                max_vx=spec.navigation.max_vx, max_omega=spec.navigation.max_wz).open()
+        return G1Base(self._loco, self.odometry(self._loco, backend), origin=spec.start.pose())
+
+    def close(self) -> None:
+        if self._loco is not None:
+            self._loco.close()
+            self._loco = None

@@ -20,7 +20,7 @@ from emopose.backends.capabilities import PlanarBase, SimulatedState
 from emopose.contract import LibraryEntry
 from emopose.execution.gesture_command import GestureCommand
 from emopose.resources import Run
-from emopose.results import markdown_table, write_results
+from emopose.results import JobOutput, markdown_table
 from emopose.robot.kinematics import HAND_ORIGIN
 from emopose.robot.pointing_ik import pointing_error
 from emopose.scene.geometry import Pose2D, angle_between, map_to_torso, torso_to_map
@@ -45,12 +45,13 @@ class PointingEvalJob:
     settle_s: float = 1.0
     max_error_deg: float = 5.0
 
-    def __call__(self, run: Run) -> dict:
+    def __call__(self, run: Run) -> JobOutput:
         spec = load_tour(self.tour_file) if self.tour_file else parse_tour(self.tour, "tour config")
         res = run.resources
         if not (isinstance(res.backend, SimulatedState) and isinstance(res.backend.planar_base, PlanarBase)):
-            raise TourConfigError("pointing_eval measures in simulation with a planar base: use backend=mujoco "
-                                  "with a backend.planar_base (as +experiment=pointing_eval sets)")
+            raise TourConfigError("pointing_eval measures in simulation with a planar base: use "
+                                  "backend=mujoco with a backend.planar_base (as +experiment=pointing_eval "
+                                  "sets)")
         install_scene(res.backend, spec, res.run_dir, video=False)
         run.session.open()
         base = MujocoBase(res.backend.planar_base)
@@ -66,7 +67,8 @@ class PointingEvalJob:
         results = {
             "gesture": entry.name, "targets": len(rows), "reachable": len(reachable),
             "max_sim_error_deg": worst,
-            "mean_sim_error_deg": float(np.mean([r["sim_error_deg"] for r in reachable])) if reachable else None,
+            "mean_sim_error_deg": (float(np.mean([r["sim_error_deg"] for r in reachable])) if reachable
+                                   else None),
             "max_fk_error_deg": max((r["fk_error_deg"] for r in reachable), default=float("nan")),
             "all_within_limit": bool(reachable) and worst <= self.max_error_deg,
             "max_error_limit_deg": self.max_error_deg, "trials": rows,
@@ -77,9 +79,7 @@ class PointingEvalJob:
         text = (f"# Pointing accuracy ({entry.name})\n\n{table}\n\n{len(reachable)}/{len(rows)} reachable; "
                 f"worst simulated error {worst:.2f} deg (limit {self.max_error_deg} deg), FK worst "
                 f"{results['max_fk_error_deg']:.2f} deg.")
-        write_results(res.run_dir, results, text)
-        print(text)
-        return results
+        return results, text
 
     def targets(self, spec) -> list[tuple[str, Pose2D, np.ndarray]]:
         """(label, robot pose, target in the map frame) for the tour's objects and the probes."""

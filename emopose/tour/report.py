@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import asdict, dataclass, field
 
+from emopose.contract import EventKind
 from emopose.results import markdown_table
 
 
@@ -25,7 +26,7 @@ class StopResult:
     aims: list[dict] = field(default_factory=list)
 
     def add_events(self, events, aims) -> None:
-        self.gestures = [e.name for e in events if e.kind == "started"]
+        self.gestures = [e.name for e in events if e.kind == EventKind.STARTED]
         self.aims = [asdict(a) for a in aims]
 
 
@@ -54,7 +55,7 @@ class TourReport:
 
     def finish(self, events, aborted: bool, unasked: list[str]) -> None:
         self.aborted, self.unasked = aborted, unasked
-        self.gesture_events = dict(Counter(e.kind for e in events if e.kind != "state"))
+        self.gesture_events = dict(Counter(e.kind for e in events if e.kind != EventKind.STATE))
 
     @property
     def max_error_m(self) -> float:
@@ -99,7 +100,8 @@ class TourReport:
 
 
 def _aim(aim: dict) -> str:
-    return f"{aim['target']} {aim['error_deg']:.1f} deg" + ("" if aim["applied"] else " (library motion kept)")
+    kept = "" if aim["applied"] else " (library motion kept)"
+    return f"{aim['target']} {aim['error_deg']:.1f} deg{kept}"
 
 
 def _cm(value: float | None) -> str:

@@ -15,7 +15,9 @@ import logging
 import math
 from functools import partial
 
-from emopose.planners.base import Planner
+from emopose.contract import EventKind
+from emopose.execution.gesture_command import State
+from emopose.planners.base import ModalPlanner, Planner, PlannerMode
 from emopose.resources import Run
 from emopose.scene.view import SceneView
 from emopose.tour.camera import Camera
@@ -32,7 +34,7 @@ DEFAULT_ANSWER = "That is a good question; let me tell you more about it after t
 
 
 class TourRunner:
-    """Runs one tour in `run`: its turn runner says the lines and keeps the dialogue history, and the
+    """Runs one tour in `run`: its turn runner says the lines and keeps the dialogue, and the
     resources' scene slot tells the aim stage what the robot is looking at."""
 
     def __init__(self, run: Run, spec: TourSpec, base: MobileBase, camera: Camera,
@@ -65,7 +67,7 @@ class TourRunner:
             if not self.aborted and self.spec.closing:
                 closing = self.say(self.spec.closing, "closing")
                 self.voice.finish(closing)
-                self.turns.history.append({"role": "assistant", "content": closing.text})
+                self.turns.dialogue.said(closing.text)
         finally:
             self.come_to_rest()
             self.report.finish(self.sequencer.events.since(first_event), self.aborted,
@@ -83,19 +85,20 @@ class TourRunner:
                 self.say(stop.approach, "approach")
             else:
                 self.voice.speak_only(stop.approach, "approach")
-            self.turns.history.append({"role": "assistant", "content": stop.approach})
+            self.turns.dialogue.said(stop.approach)
         self.event("depart", stop=stop.name, goal=goal.as_dict())
         events_before, exchanges_before = self.sequencer.events.total, len(self.report.exchanges)
         leg = self.navigator.go_to(goal, poll=lambda t: self._poll("leg", stop.name, t), handle=self.answer)
-        started = sum(e.kind == "started" for e in self.sequencer.events.since(events_before))
+        started = sum(e.kind == EventKind.STARTED for e in self.sequencer.events.since(events_before))
         answered = sum(len(x.gestures) for x in self.report.exchanges[exchanges_before:])  # given standing
         truth = self.base.true_pose() if isinstance(self.base, GroundTruthBase) else None
+        arrived = truth or leg.odometry  # where the robot really is, when the simulator knows
         result = StopResult(
             name=stop.name, reached=leg.reached, leg_s=leg.duration_s, pauses=leg.pauses,
             odometry_error_m=leg.odometry_error_m,
             true_error_m=truth.distance_to(goal) if truth else None,
-            yaw_error_deg=abs(math.degrees((truth or leg.odometry).heading_error_to(goal))),
-            within_tolerance=(truth or leg.odometry).distance_to(goal) <= self.spec.navigation.stop_tolerance_m,
+            yaw_error_deg=abs(math.degrees(arrived.heading_error_to(goal))),
+            within_tolerance=arrived.distance_to(goal) <= self.spec.navigation.stop_tolerance_m,
             gestures_while_walking=started - answered)
         self.event("arrive", stop=stop.name, reached=leg.reached, odometry=leg.odometry.as_dict(),
                    true=truth.as_dict() if truth else None)
@@ -113,7 +116,7 @@ class TourRunner:
             # Between pieces of one narration the next piece's gestures may queue behind this one's.
             question = self.voice.finish(line, poll=poll, wait_for_gestures=not pieces)
             result.narration.append(line.text)
-            self.turns.history.append({"role": "assistant", "content": _spoken(line)})
+            self.turns.dialogue.said(_spoken(line))
             offset += line.stopped_at_s if question is not None else line.speech.duration_s
             if question is None:
                 continue
@@ -139,27 +142,28 @@ class TourRunner:
         """Answer one question; returns whether the tour carries on."""
         walking = question.where.startswith("leg") or self._moving_when_asked
         self.event("question", text=question.text, where=question.where, base_moving=self._moving_when_asked)
-        self.voice.cut_short()
+        self.turns.silence()
         if self.scene.view is not None:
             self.scene.view.base = self.base.odometry()
         exchange = Exchange(question.text, question.where, self.world.stream_time, self._moving_when_asked)
         events_before = self.sequencer.events.total
         if wants_abort(question.text):
-            line = self.say(self.spec.abort_reply, "abort", extra_history=_asked(question))
+            line = self.say(self.spec.abort_reply, "abort", question=question.text)
             exchange.aborted = self.aborted = True
         else:
             image = self.camera.frame_png() if asks_about_scene(question.text) else None
             exchange.image_attached = image is not None
-            if getattr(self.answer_planner, "mode", None) == "respond":  # the planner answers the visitor itself
+            answerer = self.answer_planner
+            if isinstance(answerer, ModalPlanner) and answerer.mode is PlannerMode.RESPOND:  # answers itself
                 line = self.say(question.text, "answer", image=image, planner=self.answer_planner)
             else:  # a narrating planner gestures a prepared answer, with the question in its history
                 line = self.say(question.answer or DEFAULT_ANSWER, "answer", image=image,
-                                extra_history=_asked(question))
+                                question=question.text)
         self.voice.finish(line)
         exchange.answer = line.text
-        exchange.gestures = [e.name for e in self.sequencer.events.since(events_before) if e.kind == "started"]
-        self.turns.history.extend([{"role": "user", "content": question.text},
-                                   {"role": "assistant", "content": line.text}])
+        exchange.gestures = [e.name for e in self.sequencer.events.since(events_before)
+                             if e.kind == EventKind.STARTED]
+        self.turns.dialogue.exchange(question.text, line.text)
         self.report.exchanges.append(exchange)
         if walking and not self.spec.gesture_while_walking:
             self.voice.to_rest()
@@ -168,8 +172,8 @@ class TourRunner:
 
     # -- helpers -----------------------------------------------------------------------------
     def say(self, text: str, kind: str, image: bytes | None = None, planner: Planner | None = None,
-            extra_history: tuple[dict, ...] = ()) -> Line:
-        line = self.voice.perform(text, kind, image, planner, extra_history)
+            question: str | None = None) -> Line:
+        line = self.voice.perform(text, kind, image, planner, question)
         self.event("say", kind=kind, text=line.text, speech_s=line.speech.duration_s)
         return line
 
@@ -177,18 +181,14 @@ class TourRunner:
         self.navigator.halt()
         sequencer = self.sequencer
         if sequencer.active is not None or sequencer.pending:
-            self.voice.cut_short()
+            self.turns.silence()
         self.voice.to_rest(timeout_s=10.0)
-        self.report.ended_at_rest = sequencer.state.value == "idle" and not self.base.moving()
+        self.report.ended_at_rest = sequencer.state == State.IDLE and not self.base.moving()
         self.report.sim_time_s = self.world.stream_time
 
     def event(self, what: str, **payload) -> None:
         self.world.record("/tour/event", {"event": what, **payload})
         log.info("tour %s %s", what, payload)
-
-
-def _asked(question: Question) -> tuple[dict, ...]:
-    return ({"role": "user", "content": question.text},)
 
 
 def _spoken(line: Line) -> str:

@@ -14,10 +14,10 @@ import math
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from emopose.contract import MAX_REPLY_CHARS
 from emopose.scene.geometry import Pose2D
 
 NAME = r"^[a-z][a-z0-9_]{0,63}$"
-LINE_LIMIT = 200  # one planned line; the parse stage keeps 200 reply characters (narration is chunked)
 
 
 class TourConfigError(ValueError):
@@ -56,7 +56,7 @@ class StopSpec(_Strict):
     title: str | None = None
     pose: PoseSpec
     narration: str = Field(min_length=1)  # any length: planned and spoken in chunks of whole sentences
-    approach: str | None = Field(default=None, max_length=LINE_LIMIT)  # spoken while walking to this stop
+    approach: str | None = Field(default=None, max_length=MAX_REPLY_CHARS)  # said while walking to this stop
     objects: tuple[ObjectSpec, ...] = ()
     point_at: str | None = None  # default pointing target when the stop has several objects
 
@@ -64,11 +64,11 @@ class StopSpec(_Strict):
 class InterruptionSpec(_Strict):
     """A visitor speaking at a stop (during its narration) or during the leg that leads to a stop."""
 
-    text: str = Field(min_length=1, max_length=LINE_LIMIT)
+    text: str = Field(min_length=1, max_length=MAX_REPLY_CHARS)
     at_stop: str | None = None
     during_leg: str | None = None  # the stop this leg leads to
     after_s: float = Field(default=0.0, ge=0.0)  # into the narration / the leg
-    answer: str | None = Field(default=None, max_length=LINE_LIMIT)  # said by narrating planners (keyword, local)
+    answer: str | None = Field(default=None, max_length=MAX_REPLY_CHARS)  # said by narrating planners
 
     @model_validator(mode="after")
     def _one_place(self) -> InterruptionSpec:
@@ -106,9 +106,9 @@ class TourSpec(_Strict):
     stops: tuple[StopSpec, ...] = Field(min_length=1)
     route: tuple[str, ...] | None = None  # stop names in visiting order; default: the stops as listed
     interruptions: tuple[InterruptionSpec, ...] = ()
-    closing: str | None = Field(default=None, max_length=LINE_LIMIT)  # said after the last stop
+    closing: str | None = Field(default=None, max_length=MAX_REPLY_CHARS)  # said after the last stop
     abort_reply: str = Field(default="Of course, we will end the tour here. Thank you for visiting!",
-                             min_length=1, max_length=LINE_LIMIT)
+                             min_length=1, max_length=MAX_REPLY_CHARS)
     gesture_while_walking: bool = False
     navigation: NavigationSpec = NavigationSpec()
     odometry_noise: OdometryNoiseSpec = OdometryNoiseSpec()

@@ -40,7 +40,8 @@ def check_names(spec: TourSpec) -> list[str]:
             problems.append(f"stops[{k}] '{stop.name}'.point_at = '{stop.point_at}' is not one of its "
                             f"objects {objects}")
     for k, item in enumerate(spec.interruptions):
-        field, target = ("at_stop", item.at_stop) if item.at_stop is not None else ("during_leg", item.during_leg)
+        field, target = (("at_stop", item.at_stop) if item.at_stop is not None
+                         else ("during_leg", item.during_leg))
         if target not in stop_names:
             problems.append(f"interruptions[{k}].{field} = '{target}' is not a stop; stops are {stop_names}")
         elif spec.route is not None and target not in spec.route:

@@ -1,4 +1,5 @@
-"""The simulated planar base (a PlanarBase, e.g. the MuJoCo backend's) as a MobileBase, with dead-reckoning odometry.
+"""The simulated planar base (a PlanarBase, e.g. the MuJoCo backend's) as a MobileBase, with dead-reckoning
+odometry; SimTourBase opens it for the tour (tour/base=sim).
 
 Odometry integrates the base's body-frame velocity each control period, as leg odometry does,
 with optional seeded Gaussian noise on the velocities, so it drifts from the simulated truth the
@@ -13,8 +14,10 @@ import math
 
 import numpy as np
 
-from emopose.backends.capabilities import PlanarBase
+from emopose.backends.base import Backend
+from emopose.backends.capabilities import PlanarBase, SimulatedState
 from emopose.scene.geometry import Pose2D, wrap_angle
+from emopose.tour.scenario import TourConfigError, TourSpec
 
 
 class MujocoBase:
@@ -78,5 +81,25 @@ class MujocoBase:
         o = self._odom
         yaw_mid = o.yaw + 0.5 * wz * dt  # midpoint heading: exact for constant-curvature arcs
         c, s = math.cos(yaw_mid), math.sin(yaw_mid)
-        self._odom = Pose2D(o.x + (c * vx - s * vy) * dt, o.y + (s * vx + c * vy) * dt, wrap_angle(o.yaw + wz * dt))
+        self._odom = Pose2D(o.x + (c * vx - s * vy) * dt, o.y + (s * vx + c * vy) * dt,
+                            wrap_angle(o.yaw + wz * dt))
         self.travelled_m += math.hypot(vx, vy) * dt
+
+
+class SimTourBase:
+    """tour/base=sim: the simulated backend's planar base, placed at the tour's start, its odometry
+    as noisy as the scenario says."""
+
+    def open(self, backend: Backend, spec: TourSpec) -> MujocoBase:
+        planar = backend.planar_base if isinstance(backend, SimulatedState) else None
+        if not isinstance(planar, PlanarBase):
+            raise TourConfigError(f"tour/base=sim needs a simulated planar base: backend={backend.name} "
+                                  "has none; use backend=mujoco with a backend.planar_base (as "
+                                  "+experiment=tour_lab sets), or tour/base=g1 on the robot")
+        noise = spec.odometry_noise
+        base = MujocoBase(planar, noise.velocity_std, noise.yaw_rate_std, noise.seed)
+        base.place(spec.start.pose())
+        return base
+
+    def close(self) -> None:
+        """Nothing to release: the simulator owns its base."""

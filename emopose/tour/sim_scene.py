@@ -32,8 +32,9 @@ def build_scene_spec(spec: TourSpec, model_path: str | Path | None = None, fast_
                       rgba=rgba, contype=0, conaffinity=0)
         post = obj.position[2] - obj.size[2]
         if post > 0.02:
-            body.add_geom(name=f"post_{obj.name}", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[0.02, post / 2, 0],
-                          pos=[0, 0, -obj.size[2] - post / 2], rgba=[0.3, 0.3, 0.32, 1], contype=0, conaffinity=0)
+            body.add_geom(name=f"post_{obj.name}", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                          size=[0.02, post / 2, 0], pos=[0, 0, -obj.size[2] - post / 2],
+                          rgba=[0.3, 0.3, 0.32, 1], contype=0, conaffinity=0)
     (x_lo, x_hi), (y_lo, y_hi) = spec.arena.x, spec.arena.y
     cx = (x_lo + x_hi) / 2
     span = max(x_hi - x_lo, y_hi - y_lo)

@@ -9,12 +9,13 @@ while walking).
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from emopose.contract import MAX_REPLY_CHARS
 from emopose.execution.sequencer import Sequencer, State
 from emopose.planners.base import Planner
+from emopose.sentences import sentence_span, split_sentences
 from emopose.speech.clip import SpeechClip, Synthesizer
 from emopose.speech.player import Player
 from emopose.tour.interruptions import Question
@@ -22,21 +23,12 @@ from emopose.tour.world import TourWorld
 from emopose.turn.model import Turn
 from emopose.turn.runner import TurnRunner
 
-_SENTENCE_END = re.compile(r"[.!?]+[\"')\]]*\s+")
-# The parse stage keeps at most 200 characters of a model's reply (stages/parse.py, _text), so a
-# longer line is planned and spoken in chunks of whole sentences.
-LINE_LIMIT = 200
 
-
-def sentence_chunks(text: str, limit: int = LINE_LIMIT) -> list[str]:
-    """Whole sentences packed into pieces of at most `limit` characters (a longer sentence is cut at words)."""
-    sentences, start = [], 0
-    for match in _SENTENCE_END.finditer(text):
-        sentences.append(text[start:match.end()].strip())
-        start = match.end()
-    sentences.append(text[start:].strip())
+def sentence_chunks(text: str, limit: int = MAX_REPLY_CHARS) -> list[str]:
+    """Whole sentences packed into pieces of at most `limit` characters (a longer sentence is cut at words):
+    a plan's reply holds no more, so a longer line is planned and spoken piece by piece."""
     chunks: list[str] = []
-    for sentence in filter(None, sentences):
+    for sentence in split_sentences(text):
         while len(sentence) > limit:  # rare: one very long sentence
             cut = sentence.rfind(" ", 0, limit)
             cut = cut if cut > 0 else limit
@@ -62,9 +54,8 @@ class Line:
         """The text from the sentence that was being spoken when the line was cut short."""
         if self.stopped_at_s is None or self.stopped_at_s >= self.speech.duration_s:
             return ""
-        pos = _char_at(self.speech, self.stopped_at_s)
-        starts = [0] + [m.end() for m in _SENTENCE_END.finditer(self.text) if m.end() <= pos]
-        return self.text[starts[-1]:].strip()
+        start, _ = sentence_span(self.text, _char_at(self.speech, self.stopped_at_s))
+        return self.text[start:].strip()
 
 
 def _char_at(speech: SpeechClip, t: float) -> int:
@@ -81,11 +72,12 @@ class TourVoice:
         self.synthesizer, self.player, self.sequencer = synthesizer, player, sequencer
 
     def perform(self, utterance: str, kind: str, image: bytes | None = None, planner: Planner | None = None,
-                extra_history: tuple[dict, ...] = ()) -> Line:
-        """Plan `utterance` (with the dialogue so far) and start saying it with its gestures."""
-        # The tour writes the dialogue itself once a line has been said: a narration line is the robot's
+                question: str | None = None) -> Line:
+        """Plan `utterance` (with the dialogue so far, and the visitor's `question` it answers) and start
+        saying it with its gestures."""
+        # The tour adds to the dialogue itself once a line has been said: a narration line is the robot's
         # own (no visitor said it), and a line cut short counts only as far as it was spoken.
-        turn = self.turns.run(utterance, image, extra_history=extra_history, planner=planner, remember=False)
+        turn = self.turns.run(utterance, image, planner=planner, question=question, remember=False)
         return Line(kind, turn.plan.reply, turn.speech, turn.dispatched.speech_start, turn)
 
     def speak_only(self, text: str, kind: str) -> Line:
@@ -106,15 +98,10 @@ class TourVoice:
             question = poll(now - line.speech_start) if poll is not None else None
             if question is not None:
                 line.stopped_at_s = now - line.speech_start
-                self.cut_short()
+                self.turns.silence()
                 return question
             self.world.advance()
         return None
-
-    def cut_short(self) -> None:
-        """Stop talking and clear pending gestures, blending from the current pose toward neutral."""
-        self.player.stop()
-        self.sequencer.interrupt([], now=self.world.now())
 
     def to_rest(self, timeout_s: float = 5.0) -> bool:
         """Bring the arms back to neutral now (skipping the hold) and wait until they are there."""

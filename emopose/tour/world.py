@@ -1,6 +1,6 @@
 """Time for the tour: one control period at a time, on a virtual or a real clock.
 
-With a FakeClock (simulation) the tour owns the 50 Hz loop and ticks it itself, so physics, the
+On a virtual clock (simulation) the tour owns the 50 Hz loop and ticks it itself, so physics, the
 sequencer, the base controller and scripted questions all advance in lockstep and a run is as fast
 as the CPU allows. With a real clock (the G1) the loop runs on its own thread and advance() just
 waits one period. Either way the base integrates its odometry after each period, and the base's

@@ -78,13 +78,14 @@ class GestureTiming:
     target_s: float
     arrival_s: float
     fit: Fit
-    blend_in: bool = False      # the first segment blends from the previous gesture's stroke (co-articulation)
+    blend_in: bool = False      # first segment blends from the previous gesture's stroke (co-articulation)
     scale: float = 1.0          # time scale of the preparation
     cut: bool = False           # ends after its stroke: the next gesture co-articulates from there
 
     def as_json(self) -> dict:
-        return {"times": [round(t, 4) for t in self.times], "stroke": list(self.stroke), "target_s": self.target_s,
-                "arrival_s": self.arrival_s, "fit": self.fit, "blend_in": self.blend_in, "scale": self.scale, "cut": self.cut}
+        return {"times": [round(t, 4) for t in self.times], "stroke": list(self.stroke),
+                "target_s": self.target_s, "arrival_s": self.arrival_s, "fit": self.fit,
+                "blend_in": self.blend_in, "scale": self.scale, "cut": self.cut}
 
 
 @dataclass(frozen=True)
@@ -129,7 +130,8 @@ class Submission:
     play_at: float = float("-inf")
 
     def as_json(self) -> dict:
-        return {"speech_start": self.speech_start, "play_at": self.play_at, "submission_s": list(self.submission_s),
+        return {"speech_start": self.speech_start, "play_at": self.play_at,
+                "submission_s": list(self.submission_s),
                 "commands": [{"id": c.id, "record": c.record, "name": c.name, "release_at": c.release_at,
                               "duration_s": c.duration, "label": c.label} for c in self.commands]}
 
@@ -158,7 +160,8 @@ def _speech_json(clip: SpeechClip) -> dict:
 
 def _json(value: object) -> object:
     if isinstance(value, PlanRequest):
-        return {"utterance": value.utterance, "history": list(value.history), "image": value.image is not None}
+        return {"utterance": value.utterance, "history": list(value.history),
+                "image": value.image is not None}
     if isinstance(value, PlannerOutput):
         return {"raw": value.raw, "latency_s": value.latency_s, "fallback": value.fallback,
                 "error": value.error, "meta": value.meta}

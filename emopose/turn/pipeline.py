@@ -39,7 +39,8 @@ class PipelineError(ValueError):
 class Pipeline:
     def __init__(self, stages: Mapping[str, Stage] | Sequence[Stage], hooks: Sequence[Hook] = (),
                  inputs: Sequence[str] = PLANNED) -> None:
-        """`inputs`: the Turn fields filled in before the first stage (a pipeline from resolve on takes a plan)."""
+        """`inputs`: the Turn fields filled in before the first stage (a pipeline from resolve on
+        takes a plan)."""
         items = list(stages.values()) if isinstance(stages, Mapping) else list(stages)
         self.stages: list[Stage] = [s for s in items if s is not None]
         self.hooks, self.inputs = tuple(hooks), tuple(inputs)
@@ -48,6 +49,13 @@ class Pipeline:
     def with_hooks(self, *hooks: Hook) -> Pipeline:
         return Pipeline(self.stages, (*self.hooks, *hooks), self.inputs)
 
+    def reconfigured(self, **changes: Callable[[Any], Stage]) -> Pipeline:
+        """A copy in which the stage called `name` is replaced by changes[name](stage), for each name it
+        has (an ablated stage stays ablated); hooks and inputs are kept. The stages' own methods make
+        the re-configured copies (e.g. ScheduleStage.in_mode)."""
+        return Pipeline([changes[s.name](s) if s.name in changes else s for s in self.stages],
+                        self.hooks, self.inputs)
+
     def _check_order(self, first: int, inputs: Sequence[str]) -> None:
         known, available = set(Turn.field_names()), set(inputs)
         for stage in self.stages[first:]:
@@ -55,7 +63,8 @@ class Pipeline:
                 raise PipelineError(f"{stage!r} is not a stage: it needs name, reads, writes and __call__")
             unknown = [f for f in (*stage.reads, *stage.writes) if f not in known]
             if unknown:
-                raise PipelineError(f"stage '{stage.name}' names {unknown}, which are not Turn fields {sorted(known)}")
+                raise PipelineError(f"stage '{stage.name}' names {unknown}, "
+                                    f"which are not Turn fields {sorted(known)}")
             missing = [r for r in stage.reads if r not in available]
             if missing:
                 raise PipelineError(

@@ -1,12 +1,14 @@
 """The turn runner: the one function that runs a turn, for every caller (jobs, web UI, tour, suites).
 
 It owns the planner call (always wrapped in the thinking gesture when one is configured), the stages,
-the dialogue history and the recording: a pipeline hook writes every value a stage produces to its
-MCAP channel (`/plan`, `/resolved`, ...) as `Turn.field_json` serialises it, the moment it exists.
+the dialogue (emopose/turn/dialogue.py) and the recording: a pipeline hook writes every value a stage
+produces to its MCAP channel (`/plan`, `/resolved`, ...) as `Turn.field_json` serialises it, the moment
+it exists.
 A scripted Plan (a suite item, a button in the web UI, a robot check) enters at the first stage that
 reads a plan, with no planner call and no JSON round trip.
 A streaming planner's reply (run_streamed) is performed sentence by sentence while the model writes:
 each sentence is a Turn of its own, recorded like any other (emopose/turn/stream_pipelines.py).
+silence() is the one way to stop talking and clear the gestures (an interrupt, a visitor's question).
 """
 
 from __future__ import annotations
@@ -22,7 +24,9 @@ from emopose.contract import Plan
 from emopose.llm.errors import LLMCallError
 from emopose.planners.base import Planner, PlanRequest
 from emopose.planners.streaming import SentencePlans, StreamingPlanner
+from emopose.stages.dispatch import Dispatch
 from emopose.sync.recording import TIMELINE, speech_timeline
+from emopose.turn.dialogue import Dialogue
 from emopose.turn.model import ResolvedGesture, Turn
 from emopose.turn.pipeline import Pipeline, PipelineError, Stage
 from emopose.turn.session import Session
@@ -36,7 +40,7 @@ class TurnRunner:
     pipeline: Pipeline
     session: Session
     thinking: ThinkingGesture | None = None
-    history: list[dict] = field(default_factory=list)
+    dialogue: Dialogue = field(default_factory=Dialogue)
 
     def __post_init__(self) -> None:
         self._recorded = self.pipeline.with_hooks(self._recording_hook)
@@ -44,24 +48,23 @@ class TurnRunner:
         self._stream_lock = threading.Lock()
 
     def with_pipeline(self, pipeline: Pipeline) -> TurnRunner:
-        """The same runner (session, planner, history) running other stages: a suite's variant."""
+        """The same runner (session, planner, dialogue) running other stages: a suite's variant."""
         return replace(self, pipeline=pipeline)
 
-    def run(self, utterance: str, image: str | bytes | None = None, *, use_history: bool = True,
-            extra_history: tuple[dict, ...] = (), planner: Planner | None = None, remember: bool = True) -> Turn:
-        """Plan and execute one utterance through the whole pipeline; it joins the dialogue history.
+    def run(self, utterance: str, image: str | bytes | None = None, *, planner: Planner | None = None,
+            question: str | None = None, remember: bool = True) -> Turn:
+        """Plan and execute one utterance through the whole pipeline; it joins the dialogue as an exchange.
 
         `planner` replaces the configured one for this turn (the tour answers visitors with a sibling);
-        `remember=False` leaves the history to the caller (the tour records what was actually said)."""
+        `question` and `remember=False` are the tour's, which says prepared lines and adds to the dialogue
+        what was actually said (Dialogue.request, Dialogue.said)."""
         self.session.open()
-        history = (tuple(self.history) if use_history else ()) + tuple(extra_history)
-        turn = Turn(PlanRequest(utterance=utterance, history=history, image=image))
+        turn = Turn(self.dialogue.request(utterance, image, question))
         self._record(turn, "request")
         self.plan(turn, planner or self.planner)
         self._recorded.run(turn)
         if remember:
-            self.history.extend([{"role": "user", "content": utterance},
-                                 {"role": "assistant", "content": turn.plan.reply}])
+            self.dialogue.exchange(utterance, turn.plan.reply)
         return turn
 
     @property
@@ -82,11 +85,12 @@ class TurnRunner:
     def run_streamed(self, utterance: str, image: str | bytes | None = None,
                      on_turn: Callable[[Turn], None] | None = None) -> StreamedReply:
         """Speak the streaming planner's reply sentence by sentence as it arrives; each sentence is a Turn
-        (`on_turn` hears each once handed over). The reply joins the history as far as it was spoken."""
+        (`on_turn` hears each once handed over). The reply joins the dialogue as far as it was spoken."""
         if not self.streams:
-            raise ValueError(f"planner {self.planner.name} does not stream; use planner=annotate planner.stream=true")
+            raise ValueError(f"planner {self.planner.name} does not stream; "
+                             "use planner=annotate planner.stream=true")
         self.session.open()
-        request = PlanRequest(utterance=utterance, history=tuple(self.history), image=image)
+        request = self.dialogue.request(utterance, image)
         plans = self.planner.stream(request)
         with self._stream_lock:
             self._stream, reply = plans, StreamedReply([])
@@ -100,15 +104,28 @@ class TurnRunner:
             plans.cancel()  # closes the HTTP stream whatever ended the loop
         if reply.turns and not reply.cancelled and self._streamed.dispatch is not None:
             self._streamed.dispatch.wait()
-        self.history.extend([{"role": "user", "content": utterance}, {"role": "assistant", "content": reply.text}])
+        self.dialogue.exchange(utterance, reply.text)
         return reply
 
     def cancel(self) -> None:
-        """Stop the reply streaming now (an interrupt): no further sentence is performed. Any thread."""
+        """Stop the reply streaming now: no further sentence is performed. Any thread."""
         with self._stream_lock:
             plans, self._stream = self._stream, None
         if plans is not None:
             plans.cancel()
+
+    def silence(self) -> None:
+        """Stop talking and clear the gestures now, from any thread: a reply still streaming stops first (no
+        sentence after this one), the audio stops, and the arms blend from where they are toward neutral."""
+        self.cancel()
+        loop = self.session.loop
+        loop.sequencer.interrupt([], now=loop.clock.now())
+        if self._dispatch is not None:  # the stage that started the audio
+            self._dispatch.player.stop()
+
+    @cached_property
+    def _dispatch(self) -> Dispatch | None:
+        return next((s for s in self.pipeline.stages if isinstance(s, Dispatch)), None)
 
     def _perform(self, request: PlanRequest, plans: SentencePlans, reply: StreamedReply,
                  on_turn: Callable[[Turn], None]) -> None:
@@ -125,17 +142,10 @@ class TurnRunner:
                 self._record(turn, "planner_output")
                 (self._streamed.rest if reply.turns else self._streamed.first).run(turn)
                 if self._stream is not plans:  # the interrupt came while this sentence was handed over
-                    self._silence()
+                    self.silence()  # undo it
                     return
                 reply.turns.append(turn)
                 on_turn(turn)
-
-    def _silence(self) -> None:
-        """Undo a sentence handed over after the interrupt that should have cleared it."""
-        dispatch = self._streamed.dispatch
-        if dispatch is not None:
-            dispatch.loop.sequencer.interrupt([], now=dispatch.loop.clock.now())
-            dispatch.player.stop()
 
     @cached_property
     def _streamed(self) -> StreamPipelines:
@@ -155,7 +165,8 @@ class TurnRunner:
             self._record(turn, name)
         start = next((s.name for s in self.pipeline.stages if entry in s.reads), None)
         if start is None:
-            raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} reads {entry}")
+            raise PipelineError(f"a scripted plan has nowhere to enter: no stage of {self.pipeline.names} "
+                                f"reads {entry}")
         self._recorded.run(turn, start)
         return turn
 

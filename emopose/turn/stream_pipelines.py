@@ -13,12 +13,10 @@ TurnRunner.run_streamed). Each sentence runs the configured stages with three ch
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from emopose.stages.dispatch import Dispatch
-from emopose.stages.schedule import ScheduleStage
-from emopose.stages.sequence import SequenceStage
-from emopose.turn.pipeline import Pipeline, Stage
+from emopose.turn.pipeline import Pipeline
 
 
 @dataclass(frozen=True)
@@ -29,18 +27,8 @@ class StreamPipelines:
 
     @classmethod
     def derive(cls, pipeline: Pipeline, preroll_s: float) -> StreamPipelines:
-        dispatch = next((s for s in pipeline.stages if isinstance(s, Dispatch)), None)
-        first = [_sentence_stage(s, first=True, preroll_s=preroll_s) for s in pipeline.stages]
-        rest = [_sentence_stage(s, first=False, preroll_s=preroll_s) for s in pipeline.stages]
-        return cls(Pipeline(first, pipeline.hooks, pipeline.inputs), Pipeline(rest, pipeline.hooks, pipeline.inputs),
-                   dispatch)
-
-
-def _sentence_stage(stage: Stage, *, first: bool, preroll_s: float) -> Stage:
-    if isinstance(stage, Dispatch):
-        return replace(stage, until="none", follow=not first)
-    if isinstance(stage, SequenceStage) and not first:
-        return replace(stage, interrupt=False)
-    if isinstance(stage, ScheduleStage) and first and stage.timeline.max_preroll_s > preroll_s:
-        return replace(stage, timeline=replace(stage.timeline, max_preroll_s=preroll_s))
-    return stage
+        first = pipeline.reconfigured(schedule=lambda stage: stage.with_preroll_at_most(preroll_s),
+                                      dispatch=lambda stage: stage.streamed(follow=False))
+        rest = pipeline.reconfigured(sequence=lambda stage: stage.queueing(),
+                                     dispatch=lambda stage: stage.streamed(follow=True))
+        return cls(first, rest, pipeline.get("dispatch"))

@@ -20,7 +20,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 from emopose.clock import Clock
-from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.gesture_command import GestureCommand, State
 from emopose.execution.sequencer import Sequencer
 from emopose.library import MotionLibrary
 
@@ -74,6 +74,7 @@ class ThinkingGesture:
         active = sequencer.active
         if (active is not None and active.id not in ids) or any(c.id not in ids for c in sequencer.pending):
             return  # someone else's commands are running or queued; leave them to the sequencer
-        running = active is not None or sequencer.state.value == "blending"
-        log.info("plan arrived: %s the thinking motion %s", "interrupting" if running else "dropping", self.motion)
+        running = active is not None or sequencer.state == State.BLENDING
+        log.info("plan arrived: %s the thinking motion %s", "interrupting" if running else "dropping",
+                 self.motion)
         sequencer.interrupt([], now=self.clock.now())

@@ -117,7 +117,8 @@ class TimelinePlanner:
             earliest = -self.settings.max_preroll_s
             placed = self._prepare(name, anchors, stroke, step, origins, False, earliest, aim, (1.0, low))
             return placed or self._late(name, anchors, stroke, step, origins, earliest, aim)
-        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, prev.times[-1], aim, (1.0, 1.0))
+        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, prev.times[-1], aim,
+                               (1.0, 1.0))
         if placed is not None:
             return placed
         unsafe = ""
@@ -132,7 +133,8 @@ class TimelinePlanner:
                 placed.fit = "coarticulated" if cut == prev.stroke[1] else "shortened"
                 return placed
         retraction = self._retract(prev, low)
-        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, retraction[-1], aim, (1.0, low))
+        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, retraction[-1], aim,
+                               (1.0, low))
         if placed is not None:
             prev.times[prev.stroke[1]:] = retraction
             return placed
@@ -153,8 +155,8 @@ class TimelinePlanner:
     def _retract(self, prev: _Placed, scale: float) -> list[float]:
         """prev's keyframe times from its stroke end on, with the retraction time-scaled."""
         end = prev.stroke[1]
-        durations = self._durations(prev.anchors, prev.anchors[0], end, len(prev.anchors) - 1, prev.step * scale,
-                                    False)
+        durations = self._durations(prev.anchors, prev.anchors[0], end, len(prev.anchors) - 1,
+                                    prev.step * scale, False)
         return np.cumsum([prev.times[end], *durations]).tolist()
 
     @staticmethod
@@ -165,13 +167,15 @@ class TimelinePlanner:
             return np.vstack([q, q]), (1, 1), gesture.duration
         return q, gesture.resolved.entry.stroke_span, gesture.duration / (len(q) - 1)
 
-    def _prepare(self, name, anchors, stroke, step, start_pose, blend_in, earliest, aim, scales) -> _Placed | None:
+    def _prepare(self, name, anchors, stroke, step, start_pose, blend_in, earliest, aim,
+                 scales) -> _Placed | None:
         """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
         to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
         start; None if even that would need to start before `earliest`."""
         shapes = [(anchors, stroke, None)]
         if stroke[0] >= 2:  # skip the intermediate preparation keyframes
-            shapes.append((np.vstack([anchors[:1], anchors[stroke[0]:]]), (1, stroke[1] - stroke[0] + 1), "direct"))
+            shapes.append((np.vstack([anchors[:1], anchors[stroke[0]:]]), (1, stroke[1] - stroke[0] + 1),
+                           "direct"))
         grid = np.arange(scales[0], scales[1] - 1e-9, -0.05).tolist() + [scales[1]]
         for shape, sync, how in shapes:
             for scale in np.unique(np.clip(grid, scales[1], scales[0]))[::-1]:

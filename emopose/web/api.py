@@ -88,7 +88,8 @@ async def utterance_audio(request: Request) -> dict:
     """Microphone input: transcribe with the configured ASR, then run the turn."""
     session = session_of(request)
     if not session.hears_speech:
-        raise HTTPException(409, "no speech recognition configured; type the utterance (or run with asr=litellm)")
+        raise HTTPException(409, "no speech recognition configured; "
+                                 "type the utterance (or run with asr=litellm)")
     media = request.headers.get("content-type", "").split(";")[0].strip().lower()
     if media not in AUDIO_TYPES:
         raise HTTPException(415, f"audio type {media!r} not accepted; use one of {sorted(AUDIO_TYPES)}")

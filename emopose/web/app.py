@@ -16,7 +16,7 @@ from fastapi.responses import FileResponse, JSONResponse
 from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException
 
-from emopose.library import LibraryError
+from emopose.joint_limits import LibraryError
 from emopose.web import api, studio_api, ws
 from emopose.web.security import Guard
 from emopose.web.session import LiveSession

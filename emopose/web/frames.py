@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
+from emopose.execution.worker import Worker
 from emopose.web.pose_renderer import encode_jpeg
 
 log = logging.getLogger(__name__)
@@ -64,8 +65,7 @@ class FramePump:
         self.channels = {c.name: c for c in channels}
         self._viewers = 0
         self._lock = threading.Lock()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker = Worker("emopose-frames", self._run, join_timeout_s=5)
 
     @contextmanager
     def watching(self) -> Iterator[None]:
@@ -82,26 +82,22 @@ class FramePump:
         return channel.seq, channel.jpeg
 
     def start(self) -> None:
-        if self.channels and self._thread is None:
-            self._thread = threading.Thread(target=self._run, name="emopose-frames", daemon=True)
-            self._thread.start()
+        if self.channels:
+            self._worker.start()
 
     def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout=5)
-            self._thread = None
+        self._worker.stop()
 
-    def _run(self) -> None:
+    def _run(self, stop: threading.Event) -> None:
         due = {name: 0.0 for name in self.channels}
-        while not self._stop.is_set():
+        while not stop.is_set():
             if self._viewers == 0:
-                self._stop.wait(0.1)
+                stop.wait(0.1)
                 continue
             name = min(due, key=due.get)
             wait = due[name] - time.monotonic()
             if wait > 0:
-                self._stop.wait(wait)
+                stop.wait(wait)
                 continue
             channel = self.channels[name]
             try:

@@ -49,7 +49,8 @@ class PoseRenderer:
             return True
         except Exception as exc:  # noqa: BLE001 -- any failure here means "no MuJoCo frames", not a crash
             self.error = f"{type(exc).__name__}: {exc}"[:300]
-            log.warning("MuJoCo offscreen rendering unavailable (%s); the UI draws a stick figure", self.error)
+            log.warning("MuJoCo offscreen rendering unavailable (%s); the UI draws a stick figure",
+                        self.error)
             return False
 
     @property

@@ -1,7 +1,7 @@
 """The served robot: one Run, a worker thread for turns, and a broadcast log for every page.
 
 Turns (planning, TTS, the pipeline) run through the run's TurnRunner on one worker thread, so the event
-loop never blocks and turns never overlap (the dialogue history is appended in order); the control
+loop never blocks and turns never overlap (the runner's dialogue grows in order); the control
 loop ticks on its own thread. A streamed reply publishes each sentence as a turn once it is handed over.
 Everything a page must hear about (turns, interruptions, saved motions) goes into one bounded log
 with increasing ids; each WebSocket sends what it has not sent yet, so every open page agrees.
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from emopose.backends.capabilities import SimulatedState
-from emopose.contract import GestureRecord, LibraryEntry, Plan
+from emopose.contract import EventKind, GestureRecord, LibraryEntry, Plan
 from emopose.resources import Run
 from emopose.studio.authoring import PoseStudio
 from emopose.turn.model import ResolvedGesture, Turn
@@ -53,7 +53,7 @@ class LiveSession:
         self._outcome_lock = threading.Lock()
         self._events_seen = res.sequencer.events.total
         self._cue_of: dict[int, tuple[dict, int]] = {}  # command id -> (published turn message, cue index)
-        self._refusals: dict[int, dict] = {}  # command id -> outcome, seen before or after its turn was published
+        self._refusals: dict[int, dict] = {}  # command id -> outcome (may precede its turn)
         self._strokes: dict[int, float] = {}  # command id -> clock time its stroke arrived
 
     # -- turns (called from the event loop; the work runs on the worker thread) ----------------
@@ -81,10 +81,10 @@ class LiveSession:
     def _say(self, text: str, image: bytes | None) -> dict:
         self.publish({"type": "turn_started", "utterance": text})
         published: list[dict] = []
-        reply = self.run.runner.respond(text, image, lambda turn: published.append(self._publish_turn(turn, "say")))
+        reply = self.run.runner.respond(text, image, lambda t: published.append(self._publish_turn(t, "say")))
         whole = published and reply.error is None and not reply.cancelled
-        return published[-1] if whole else self.publish({"type": "reply_stopped", "error": reply.error,
-                                                         "cancelled": reply.cancelled, "sentences": len(published)})
+        stopped = {"type": "reply_stopped", "error": reply.error, "cancelled": reply.cancelled}
+        return published[-1] if whole else self.publish({**stopped, "sentences": len(published)})
 
     def _gesture(self, name: str, intensity: int, text: str | None) -> dict:
         """One record naming the variant, from resolve to dispatch like any plan (no planner call)."""
@@ -100,7 +100,8 @@ class LiveSession:
         """A Pose Studio draft, in no library: from modulation to dispatch like a resolved record, so the
         joint limits and the sequencer's self-collision check judge it as they judge any gesture."""
         record = GestureRecord(cls=entry.cls, intensity=intensity, confidence=1.0)
-        turn = self.run.runner.run_plan(Plan.scripted("", record), resolved=[ResolvedGesture(record, entry, "exact")])
+        resolved = [ResolvedGesture(record, entry, "exact")]
+        turn = self.run.runner.run_plan(Plan.scripted("", record), resolved=resolved)
         return self._publish_turn(turn, "draft")
 
     def _publish_turn(self, turn: Turn, kind: str) -> dict:
@@ -132,7 +133,7 @@ class LiveSession:
             cursor, self._events_seen = self._events_seen, events.total
             landed = []
             for event in events.since(cursor):
-                if event.kind == "stroke" and event.command_id is not None:
+                if event.kind == EventKind.STROKE and event.command_id is not None:
                     _remember(self._strokes, event.command_id, event.t)
                     landed.append(self._land_stroke(event.command_id))
                     continue
@@ -153,20 +154,18 @@ class LiveSession:
     def _land_stroke(self, command_id: int) -> dict | None:
         """Put an arrived stroke's time (from speech start) on its published cue; the page message."""
         message, k = self._cue_of.get(command_id, (None, None))
-        if message is None or message["cues"][k]["stroke_executed_s"] is not None or message["speech_start"] is None:
+        cue = None if message is None else message["cues"][k]
+        if cue is None or cue["stroke_executed_s"] is not None or message["speech_start"] is None:
             return None
-        executed = message["cues"][k]["stroke_executed_s"] = self._strokes[command_id] - message["speech_start"]
+        executed = cue["stroke_executed_s"] = self._strokes[command_id] - message["speech_start"]
         return {"type": "cue_stroke", "turn_id": message["turn_id"], "k": k, "executed_s": executed}
 
     def _publish_outcomes(self, landed: list[dict | None]) -> None:
-        for update in landed:
-            if update is not None:
-                self.publish(update)
+        for update in filter(None, landed):
+            self.publish(update)
 
     def interrupt(self) -> dict:
-        self.run.runner.cancel()  # a reply still streaming stops first: no sentence after this one
-        self.res.sequencer.interrupt([], now=self.res.clock.now())
-        self.res.player.stop()
+        self.run.runner.silence()
         return self.publish({"type": "interrupted"})
 
     # -- broadcast log -------------------------------------------------------------------------
@@ -197,13 +196,13 @@ class LiveSession:
     def status(self, events_from: int = 0) -> dict:
         seq, clock = self.res.sequencer, self.res.clock
         self._track_outcomes()
-        now = clock.now()
-        active = seq.active
+        now, active = clock.now(), seq.active
         events, events_next = seq.events.read(events_from)
         session = self.run.session
         return {
             "type": "state", "server_now": now, "state": seq.state.value,
-            "active": None if active is None else {"name": active.name, "label": active.label, "id": active.id},
+            "active": None if active is None
+            else {"name": active.name, "label": active.label, "id": active.id},
             "pending": [{"name": c.name, "label": c.label, "release_in_s": round(c.release_at - now, 3)}
                         for c in seq.pending],
             "events": [{"t": e.t, "kind": e.kind, "name": e.name, "detail": e.detail} for e in events],
@@ -227,8 +226,7 @@ class LiveSession:
         return {
             "backend": self.res.backend.name, "planner": self.res.planner.name,
             "tts": self.res.synthesizer.name, "library_version": self.res.library.version,
-            "asr": self.hears_speech,
-            "channels": {name: c.source for name, c in channels.items()},
+            "asr": self.hears_speech, "channels": {name: c.source for name, c in channels.items()},
             "render": self.renderer is not None and self.renderer.available,
             "render_error": None if self.renderer is None else self.renderer.error,
         }

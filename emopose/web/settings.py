@@ -59,7 +59,8 @@ class ServeSettings(BaseModel):
         if self.token is not None and not TOKEN_RE.fullmatch(self.token):
             # It travels in a cookie and a query string: keep it to URL-safe characters.
             raise ValueError(f"serve.token must be at least {MIN_TOKEN_CHARS} URL-safe characters "
-                             "(letters, digits, - _ . ~), e.g. python -c 'import secrets; print(secrets.token_urlsafe())'")
+                             "(letters, digits, - _ . ~), "
+                             "e.g. python -c 'import secrets; print(secrets.token_urlsafe())'")
         return self
 
     @classmethod

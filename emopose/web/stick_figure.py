@@ -21,7 +21,8 @@ def _flat(points: np.ndarray, view: str) -> list:
 
 
 def stick_figure(q: np.ndarray) -> dict:
-    """{'front'|'side': {'arms': [[[h, v] x 5] x 2], 'torso': [[h, v], [h, v]], 'torso_r', 'head': [h, v, r]}}."""
+    """{'front'|'side': {'arms': [[[h, v] x 5] x 2], 'torso': [[h, v], [h, v]], 'torso_r',
+    'head': [h, v, r]}}."""
     q = np.asarray(q, dtype=float).reshape(14)
     _, pos = link_frames(q)
     chain = np.concatenate([pos[:, :1, :], arm_points(q)], axis=1)  # (2 arms, root + 4 points, 3)

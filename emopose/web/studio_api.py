@@ -43,7 +43,8 @@ def library_index(request: Request) -> dict:
                 "explicit_duration": e.duration is not None} for e in snapshot.entries.values()]
     return {"version": snapshot.version, "classes": list(CLASSES), "neutral": snapshot.neutral,
             "neutral_pose": _round(library.neutral_entry.q[0]), "writable": library.write_dir is not None,
-            "limits": {"names": list(limits.names), "lower": _round(limits.lower), "upper": _round(limits.upper)},
+            "limits": {"names": list(limits.names), "lower": _round(limits.lower),
+                       "upper": _round(limits.upper)},
             "class_defaults": snapshot.class_defaults, "entries": entries}
 
 
@@ -76,12 +77,14 @@ def check(body: DraftRequest, request: Request) -> dict:
     k = len(body.keyframes)
     span = trajectory.duration
     return {
-        "intensity": report.intensity, "duration": report.duration, "default_duration": report.default_duration,
+        "intensity": report.intensity, "duration": report.duration,
+        "default_duration": report.default_duration,
         "explicit_duration": report.explicit_duration, "dt": trajectory.dt, "stretch": trajectory.stretch,
         "samples": _round(trajectory.samples), "keyframes": _round(report.keyframes),
         "keyframe_times": [span * i / max(k - 1, 1) for i in range(k)] if k > 1 else [span],
         "stroke": list(entry.stroke_span), "stroke_declared": entry.stroke is not None,
-        "keyframe_violations": report.keyframe_violations, "trajectory_violations": report.trajectory_violations,
+        "keyframe_violations": report.keyframe_violations,
+        "trajectory_violations": report.trajectory_violations,
         "levels": [vars(c) for c in report.levels], "problems": report.problems,
         "can_save": not report.problems,
         "stick": stick_frames(trajectory.samples, STICK_EVERY), "stick_dt": trajectory.dt * STICK_EVERY,

@@ -16,10 +16,11 @@ the turn is published before its gestures start, so the session adds outcomes th
 
 from __future__ import annotations
 
-from emopose.contract import trigger_position
+from emopose.contract import EventKind, trigger_position
 from emopose.turn.model import Turn
 
-NOT_PERFORMED = ("rejected", "dropped")  # sequencer event kinds that mean "this gesture did not run"
+# Sequencer event kinds that mean "this gesture did not run".
+NOT_PERFORMED = (EventKind.REJECTED, EventKind.DROPPED)
 
 
 def outcome_of(event: dict) -> dict | None:
@@ -39,21 +40,23 @@ def cue_rows(data: dict) -> list[dict]:
     outcomes = {e["command_id"]: outcome_of(e) for e in events if outcome_of(e) is not None}
     speech_start = data.get("dispatched", {}).get("speech_start")
     strokes = {e["command_id"]: e["t"] - speech_start for e in events
-               if e["kind"] == "stroke" and speech_start is not None}
+               if e["kind"] == EventKind.STROKE and speech_start is not None}
     rows = []
     for k, (record, resolved, release) in enumerate(zip(records, data["resolved"], releases)):
         command_id = ids.get(k)
         dropped = None if release is None else release["dropped"]
+        timing = None if release is None else release.get("timing")  # timeline mode only
         trigger = record["trigger"]
         start = trigger_position(reply, trigger)
         rows.append({
-            "k": k, "class": record["class"], "requested": record["variant"], "resolved": resolved["resolved"],
-            "resolved_class": resolved["resolved_class"], "rule": resolved["rule"], "intensity": record["intensity"],
-            "confidence": record["confidence"], "trigger": trigger,
-            "char_start": start, "char_end": None if start is None else start + len(trigger),
+            "k": k, "class": record["class"], "requested": record["variant"],
+            "resolved": resolved["resolved"], "resolved_class": resolved["resolved_class"],
+            "rule": resolved["rule"], "intensity": record["intensity"], "confidence": record["confidence"],
+            "trigger": trigger, "char_start": start,
+            "char_end": None if start is None else start + len(trigger),
             "release_s": None if release is None else release["release_s"],
             "how": None if release is None else release["how"],
-            "stroke_s": None if release is None or release.get("timing") is None else release["timing"]["arrival_s"],
+            "stroke_s": None if timing is None else timing["arrival_s"],
             "stroke_executed_s": strokes.get(command_id),
             "command_id": command_id,
             "outcome": {"kind": "dropped", "reason": dropped} if dropped else outcomes.get(command_id),

@@ -54,7 +54,8 @@ async def _handle(session: LiveSession, text: str | None, tasks: set, websocket:
     if text is None:
         return {"type": "error", "message": "send JSON text messages, not binary"}
     if len(text) > session.settings.max_ws_message_bytes:
-        return {"type": "error", "message": f"message larger than {session.settings.max_ws_message_bytes} bytes"}
+        return {"type": "error",
+                "message": f"message larger than {session.settings.max_ws_message_bytes} bytes"}
     try:
         message = _messages.validate_json(text)
     except ValidationError as exc:
@@ -84,7 +85,8 @@ async def _report_failure(action, websocket: WebSocket) -> None:
         await _send_quietly(websocket, {"type": "error", "message": str(exc)})
     except Exception as exc:  # a failed turn is reported, the session goes on
         log.exception("turn failed")
-        await _send_quietly(websocket, {"type": "error", "message": f"turn failed: {type(exc).__name__}: {exc}"[:300]})
+        await _send_quietly(websocket, {"type": "error",
+                                        "message": f"turn failed: {type(exc).__name__}: {exc}"[:300]})
 
 
 async def _send_quietly(websocket: WebSocket, message: dict) -> None:

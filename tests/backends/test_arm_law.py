@@ -18,7 +18,8 @@ from emopose.sync.strokes import first_within
 ROBOT_PLAIN = ArmLaw("robot_plain", 60.0, 1.5)
 ROBOT_GRAVITY = ArmLaw("robot_gravity", 60.0, 1.5, gravity_compensation=True)
 MJCF = ArmLaw("mjcf", None, None, velocity_feedforward=True, gravity_compensation=True)
-RAISED = np.array([0.1, 0.12, 0.0, 1.2, 0.0, 0.0, 0.0, -1.4, -0.3, 0.0, 1.5, 0.0, 0.0, 0.0])  # right arm forward
+# Right arm forward.
+RAISED = np.array([0.1, 0.12, 0.0, 1.2, 0.0, 0.0, 0.0, -1.4, -0.3, 0.0, 1.5, 0.0, 0.0, 0.0])
 
 
 @pytest.fixture(scope="module")

@@ -51,10 +51,14 @@ def test_a_backend_must_implement_the_whole_interface():
 
 def test_dry_run_echoes_what_it_was_sent():
     backend = DryRunBackend(initial_pose=[0.1] * 14)
+    assert not backend.is_connected
     np.testing.assert_allclose(backend.connect(None), 0.1)
-    backend.send(0.0, np.full(14, 0.2))
+    assert backend.is_connected
+    np.testing.assert_allclose(backend.send(0.0, np.full(14, 0.2)), 0.2)  # no limits: sent as asked
     np.testing.assert_allclose(backend.measured(), 0.2)
     assert backend.sent == 1
+    backend.close()
+    assert not backend.is_connected
 
 
 def test_composed_mujoco_config_attaches_the_renderer_and_the_chosen_base(compose):

@@ -141,6 +141,20 @@ def test_backend_protocol_and_zero_pose_geometry(backend):
     assert backend.contacts() == []
 
 
+def test_send_returns_the_target_clipped_to_the_joint_ranges(backend):
+    assert not backend.is_connected
+    backend.connect(None)
+    assert backend.is_connected
+    lo, hi = backend.model.jnt_range[[backend.model.joint(n).id for n in JOINT_NAMES]].T
+    asked = np.where(np.arange(14) % 2 == 0, hi + 0.5, lo - 0.5)  # every joint past a limit
+    sent = backend.send(0.0, asked)
+    np.testing.assert_allclose(sent, np.clip(asked, lo, hi))
+    inside = (lo + hi) / 2
+    np.testing.assert_allclose(backend.send(CONTROL_DT, inside), inside)
+    backend.close()
+    assert not backend.is_connected
+
+
 def test_holds_pose_with_gravity_compensation_within_torque_limits(backend):
     backend.connect(None)
     measured = run_ticks(backend, np.tile(HELD_POSE, (100, 1)))  # 2 s

@@ -24,8 +24,8 @@ def run_experiment(library_overrides, tmp_path, compose):
     """run_experiment("bench_all", "bench.path=...", ...) -> (results dict, run_dir)."""
 
     def _run(experiment: str, *overrides: str, planner: str = "keyword"):
-        cfg = compose(f"+experiment={experiment}", f"planner={planner}", "job.progress=false", *library_overrides,
-                      *overrides)
+        cfg = compose(f"+experiment={experiment}", f"planner={planner}", "job.progress=false",
+                      *library_overrides, *overrides)
         run_dir = tmp_path / experiment
         return run(cfg, run_dir), run_dir
 

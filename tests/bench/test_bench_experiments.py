@@ -9,8 +9,9 @@ import pytest
 
 from emopose.bench.suites import SuiteError
 from emopose.jobs.bench import BenchJob
-from emopose.planners.base import PlannerOutput
+from emopose.planners.base import PlannerFailure, PlannerOutput
 from emopose.planners.baselines.keyword import KeywordPlanner
+from emopose.results import JobFailure
 
 FIXTURES = Path(__file__).parent / "fixtures"
 BENCH = f"bench.path={FIXTURES / 'bench_small.jsonl'}"
@@ -75,7 +76,8 @@ def test_sequence_suite(run_experiment):
 def test_sequence_suite_refuses_variants_missing_from_the_library(run_experiment, tmp_path):
     bad = tmp_path / "seq.jsonl"
     bad.write_text(json.dumps({"id": "s1", "text": "Hello! Over there.", "labels": ["welcoming", "pointing"],
-                               "anchors": ["Hello", "Over there"], "variants": ["welcoming_a", "point_left"]}) + "\n")
+                               "anchors": ["Hello", "Over there"],
+                               "variants": ["welcoming_a", "point_left"]}) + "\n")
     with pytest.raises(SuiteError, match=r"seq.jsonl:1: field 'variants\[1\]'"):
         run_experiment("sequence_suite", f"bench.path={bad}")
 
@@ -114,11 +116,12 @@ def test_a_failing_item_is_recorded_and_the_run_continues(tmp_path):
             {"id": "c", "text": "No, never.", "label": "rejecting", "tier": "easy"}]
     suite.write_text("".join(json.dumps(r) + "\n" for r in rows))
     run = planning_run(FlakyPlanner(), tmp_path)
-    results = BenchJob(path=str(suite), progress=False, confusion=False)(run)
+    results, markdown = BenchJob(path=str(suite), progress=False, confusion=False)(run)
     preds = {p["id"]: p for p in results["predictions"]}
     assert preds["b"]["pred"] is None and "model exploded" in preds["b"]["error"]
     assert preds["a"]["pred"] == "agreeing" and preds["c"]["pred"] == "rejecting"
     assert results["failures"] == 1 and results["accuracy"]["overall"]["mean"] == pytest.approx(200 / 3)
+    assert "flaky" in markdown  # the comparison table app.run writes to results.md and prints
 
 
 def test_sampled_planner_defaults_to_five_passes(tmp_path):
@@ -127,17 +130,32 @@ def test_sampled_planner_defaults_to_five_passes(tmp_path):
 
     suite = FIXTURES / "bench_small.jsonl"
     run = planning_run(Sampled(), tmp_path)
-    results = BenchJob(path=str(suite), tiers=["easy"], progress=False, confusion=False)(run)
+    results, _ = BenchJob(path=str(suite), tiers=["easy"], progress=False, confusion=False)(run)
     assert results["passes"] == 5 and len(results["predictions"]) == 40
     assert results["accuracy"]["easy"]["sd"] == 0.0
 
 
-def test_fallback_outputs_are_counted(tmp_path):
-    class Garbled(KeywordPlanner):
-        def plan(self, request):
-            return PlannerOutput(raw='{"gestures": [{"class": "agreeing", "intensity": "loud"}]}')
+class Garbled(KeywordPlanner):
+    """Every answer is unusable (an intensity that is not a level), so every plan is a fallback."""
 
+    def plan(self, request):
+        return PlannerOutput(raw='{"gestures": [{"class": "agreeing", "intensity": "loud"}]}')
+
+
+def test_fallback_outputs_are_counted(tmp_path):
     run = planning_run(Garbled(), tmp_path)
-    results = BenchJob(path=str(FIXTURES / "bench_small.jsonl"), tiers=["easy"], progress=False,
-                       confusion=False, max_fallback_share=1.0)(run)  # 1.0: counted, not failed
+    results, _ = BenchJob(path=str(FIXTURES / "bench_small.jsonl"), tiers=["easy"], progress=False,
+                          confusion=False, max_fallback_share=1.0)(run)  # 1.0: counted, not failed
     assert results["fallbacks"] == 8 and results["failures"] == 0
+
+
+def test_too_many_fallbacks_fail_with_the_results_to_write(tmp_path):
+    run = planning_run(Garbled(), tmp_path)
+    job = BenchJob(path=str(FIXTURES / "bench_small.jsonl"), tiers=["easy"], progress=False, confusion=False,
+                   max_fallback_share=0.5)
+    with pytest.raises(JobFailure) as failed:
+        job(run)
+    assert failed.value.results["fallback_exceeded"] and failed.value.results["fallbacks"] == 8
+    assert "keyword" in failed.value.markdown  # the table app.run writes and prints before failing
+    assert isinstance(failed.value.error, PlannerFailure)
+    assert "fell back on 8 answers (100.0 % > job.max_fallback_share 50 %" in str(failed.value.error)

@@ -24,7 +24,8 @@ def test_mean_and_sample_sd():
 
 
 def test_accuracy_counts_failures_as_wrong():
-    assert accuracy([("agreeing", "agreeing"), ("doubting", None), ("neutral", "pointing"), ("neutral", "neutral")]) == 50.0
+    pairs = [("agreeing", "agreeing"), ("doubting", None), ("neutral", "pointing"), ("neutral", "neutral")]
+    assert accuracy(pairs) == 50.0
     assert accuracy([]) is None
 
 
@@ -32,10 +33,10 @@ def test_tier_accuracy_over_two_passes():
     def p(tier, label, pred, k):
         return {"tier": tier, "label": label, "pred": pred, "pass": k}
 
-    preds = [p("easy", "agreeing", "agreeing", 0), p("easy", "neutral", "neutral", 0), p("hard", "doubting", "neutral", 0),
-             p("hard", "comforting", "comforting", 0),
-             p("easy", "agreeing", "agreeing", 1), p("easy", "neutral", "pointing", 1), p("hard", "doubting", None, 1),
-             p("hard", "comforting", "comforting", 1)]
+    preds = [p("easy", "agreeing", "agreeing", 0), p("easy", "neutral", "neutral", 0),
+             p("hard", "doubting", "neutral", 0), p("hard", "comforting", "comforting", 0),
+             p("easy", "agreeing", "agreeing", 1), p("easy", "neutral", "pointing", 1),
+             p("hard", "doubting", None, 1), p("hard", "comforting", "comforting", 1)]
     acc = tier_accuracy(preds, ("easy", "medium", "hard"))
     # easy: 100, 50 -> mean 75, sd sqrt(((25)^2 * 2) / 1) = 35.355; hard: 50, 50; overall: 75, 50
     assert acc["easy"]["mean"] == 75.0 and acc["easy"]["sd"] == pytest.approx(35.35533906)

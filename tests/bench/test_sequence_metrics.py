@@ -17,7 +17,8 @@ A, B, C, D = "welcoming", "pointing", "emphasizing", "rejecting"
 
 
 def item(text, labels, anchors, variants=None, ident="x"):
-    return SequenceItem(ident, text, tuple(labels), tuple(anchors), tuple(variants or [f"{c}_a" for c in labels]))
+    variants = tuple(variants or [f"{c}_a" for c in labels])
+    return SequenceItem(ident, text, tuple(labels), tuple(anchors), variants)
 
 
 def test_aligned_step_accuracy_uses_the_longer_length():
@@ -57,7 +58,7 @@ def test_item_scores_over_under_and_variants():
     under = item_scores(it, SequencePrediction((A, C), ("Hello", "crucial"), (f"{A}_a", f"{C}_a")))
     assert under["under"] == 1 and under["aligned"] == pytest.approx(1 / 3)
     assert under["f1"] == pytest.approx(0.8)                              # P 1, R 2/3
-    assert under["variants_hit"] == 1                                     # position 1 holds C, not B's variant
+    assert under["variants_hit"] == 1  # position 1 holds C, not B's variant
     failed = item_scores(it, SequencePrediction(None))
     assert failed["failed"] == 1 and failed["over"] == failed["under"] == 0 and failed["f1"] == 0.0
 
@@ -65,7 +66,8 @@ def test_item_scores_over_under_and_variants():
 def test_suite_scores_hand_computed():
     items = [item("Hi! Over there.", [A, B], ["Hi", "Over there"], ident="s1"),
              item("No. Stop. Listen!", [D, D, C], ["No", "Stop", "Listen"], ident="s2"),
-             item("Hi. Look here. Key point. No.", [A, B, C, D], ["Hi", "Look here", "Key point", "No"], ident="s3")]
+             item("Hi. Look here. Key point. No.", [A, B, C, D], ["Hi", "Look here", "Key point", "No"],
+                  ident="s3")]
     preds = [SequencePrediction((A, B), ("Hi", "there"), (f"{A}_a", f"{B}_a")),          # exact
              SequencePrediction((D, C), ("No", "Listen"), (f"{D}_a", None)),             # under-segmented
              SequencePrediction(None)]                                                    # failed

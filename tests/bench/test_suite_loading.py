@@ -9,7 +9,8 @@ from emopose.bench.suites import SuiteError, anchor_spans, load_bench, load_cont
 
 FIXTURES = Path(__file__).parent / "fixtures"
 GOOD_BENCH = {"id": "b1", "text": "Look over there.", "label": "pointing", "tier": "easy"}
-GOOD_CONTEXT = {"id": "c1", "history": [{"role": "user", "content": "Where?"}], "text": "There.", "label": "pointing"}
+GOOD_CONTEXT = {"id": "c1", "history": [{"role": "user", "content": "Where?"}], "text": "There.",
+                "label": "pointing"}
 GOOD_SEQ = {"id": "s1", "text": "Welcome! Look over there.", "labels": ["welcoming", "pointing"],
             "anchors": ["Welcome", "over there"], "variants": ["face_wave", "point_left"]}
 VARIANT_CLASSES = {"face_wave": "welcoming", "point_left": "pointing", "shrug": "doubting"}
@@ -72,6 +73,22 @@ def test_sequence_anchor_not_in_text(tmp_path):
             "'over here'", "substring")
 
 
+def test_sync_eval_keeps_an_anchor_missing_from_the_text_for_its_say_do_check(tmp_path):
+    path = write(tmp_path, {**GOOD_SEQ, "anchors": ["Welcome", "over here"]})
+    (item,) = load_sequence(path, anchors_in_text=False)
+    assert item.anchors == ("Welcome", "over here")
+    refused(load_sequence, write(tmp_path, {**GOOD_SEQ, "anchors": ["Welcome"]}), 1, "anchors",
+            "equal lengths", anchors_in_text=False)  # every other check still applies
+
+
+def test_a_sequence_item_as_a_scripted_plan():
+    item = load_sequence(FIXTURES / "sequence_small.jsonl")[0]
+    plan = item.plan()
+    assert plan.reply == item.text and plan.source == "scripted"
+    assert [(r.cls, r.trigger, r.variant) for r in plan.records] == list(zip(item.labels, item.anchors,
+                                                                             item.variants))
+
+
 def test_sequence_anchors_out_of_order(tmp_path):
     refused(load_sequence, write(tmp_path, {**GOOD_SEQ, "anchors": ["over there", "Welcome"]}), 1, "anchors")
 
@@ -89,7 +106,8 @@ def test_sequence_unknown_label_and_variant(tmp_path):
     wrong_class = {**GOOD_SEQ, "variants": ["shrug", "point_left"]}
     refused(load_sequence, write(tmp_path, wrong_class), 1, "variants[0]", "doubting",
             variant_classes=VARIANT_CLASSES)
-    assert load_sequence(write(tmp_path, GOOD_SEQ), variant_classes=VARIANT_CLASSES)[0].spans == [(0, 7), (14, 24)]
+    item = load_sequence(write(tmp_path, GOOD_SEQ), variant_classes=VARIANT_CLASSES)[0]
+    assert item.spans == [(0, 7), (14, 24)]
 
 
 def test_anchor_spans_sequential():

@@ -20,9 +20,11 @@ def fake_job(root: Path, num: int, method: str, overall: float, overrides: list[
     job = root / str(num)
     (job / ".hydra").mkdir(parents=True)
     (job / ".hydra" / "overrides.yaml").write_text(yaml.safe_dump(overrides))
-    acc = {"easy": {"mean": overall, "sd": None}, "medium": None, "hard": None, "overall": {"mean": overall, "sd": None}}
-    (job / "results.json").write_text(json.dumps({"kind": "bench", "suite": "s.jsonl", "method": method, "n": 8,
-                                                  "passes": 1, "accuracy": acc, "predictions": [{"id": "x"}]}))
+    acc = {"easy": {"mean": overall, "sd": None}, "medium": None, "hard": None,
+           "overall": {"mean": overall, "sd": None}}
+    (job / "results.json").write_text(json.dumps({"kind": "bench", "suite": "s.jsonl", "method": method,
+                                                  "n": 8, "passes": 1, "accuracy": acc,
+                                                  "predictions": [{"id": "x"}]}))
 
 
 def test_callback_table_collects_every_job_in_job_order(tmp_path):
@@ -61,8 +63,9 @@ def test_report_names_a_missing_suite(tmp_path, library_overrides):
 def test_cli_sweep_writes_one_table(tmp_path, library_overrides):
     """The README's sweep command, on the fixture suite, with the joblib launcher."""
     sweep_dir = tmp_path / "sweep"
-    cmd = [sys.executable, "-m", "emopose", "-m", "+experiment=bench_all", "planner=keyword,tfidf,jaccard,chance",
-           f"bench.path={FIXTURES / 'bench_small.jsonl'}", f"hydra.sweep.dir={sweep_dir}",
+    cmd = [sys.executable, "-m", "emopose", "-m", "+experiment=bench_all",
+           "planner=keyword,tfidf,jaccard,chance", f"bench.path={FIXTURES / 'bench_small.jsonl'}",
+           f"hydra.sweep.dir={sweep_dir}",
            "hydra/launcher=joblib", "hydra.launcher.n_jobs=2", *library_overrides]
     done = subprocess.run(cmd, check=False, cwd=PROJECT_ROOT, capture_output=True, text=True, timeout=300,
                           env={**os.environ, "HYDRA_FULL_ERROR": "1"})

@@ -17,5 +17,7 @@ def wired(library, tmp_path):
 def gesture(library: MotionLibrary, name: str, intensity: int = 3) -> ModulatedGesture:
     """A library motion resolved exactly and modulated, as the pipeline would hand it to the schedule."""
     entry = library.get(name)
-    resolved = ResolvedGesture(GestureRecord(cls=entry.cls, variant=name, intensity=intensity), entry, "exact")
-    return ModulatedGesture(resolved, modulate_keyframes(entry.q, intensity, library.limits), entry.default_duration)
+    resolved = ResolvedGesture(GestureRecord(cls=entry.cls, variant=name, intensity=intensity), entry,
+                               "exact")
+    return ModulatedGesture(resolved, modulate_keyframes(entry.q, intensity, library.limits),
+                            entry.default_duration)

@@ -12,6 +12,7 @@ from emopose.clock import FakeClock
 from emopose.execution.control_loop import ControlLoop, LoopStats
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.recording import Recorder, read_recording
 
 
 class SleepyClock(FakeClock):
@@ -37,7 +38,7 @@ class TimedBackend(DryRunBackend):
     def send(self, t: float, q: np.ndarray) -> None:
         self.sent_at.append(self.clock.now())
         self.clock.advance(self.slow.get(len(self.sent_at), 0.0))
-        super().send(t, q)
+        return super().send(t, q)
 
 
 @pytest.fixture
@@ -105,3 +106,28 @@ def test_a_long_run_keeps_the_window_bounded(make_loop):
     loop.run_until(lambda: False, 2 * loop.stats.window * CONTROL_DT)
     assert loop.stats.ticks >= 2 * loop.stats.window - 1
     assert len(loop.stats.lateness_s) == loop.stats.window
+
+
+class ClampingBackend(DryRunBackend):
+    """Sends at most `ceiling` on every joint, as a backend clamps to its limits."""
+
+    def __init__(self, ceiling: float) -> None:
+        super().__init__()
+        self.ceiling = ceiling
+
+    def send(self, t: float, q: np.ndarray) -> np.ndarray:
+        return super().send(t, np.minimum(q, self.ceiling))
+
+
+def test_the_loop_records_what_the_backend_sent_not_what_was_asked(library, rest, tmp_path):
+    clock = FakeClock()
+    sequencer = Sequencer(TrajectoryBuilder(library.limits), rest)
+    ceiling = float(np.max(rest)) - 0.1  # below the rest pose on at least one joint
+    loop = ControlLoop(sequencer, ClampingBackend(ceiling), clock)
+    with Recorder(tmp_path / "run.mcap", clock=clock) as recorder:
+        loop.begin(rest, recorder)
+        returned = loop.tick()
+    assert np.max(returned) == pytest.approx(ceiling)
+    commands = read_recording(tmp_path / "run.mcap")["/joints/command"]
+    assert len(commands) == 1 and np.allclose(commands[0][1]["q"], returned)
+    assert not np.allclose(commands[0][1]["q"], rest)  # the requested pose was not what went out

@@ -1,7 +1,7 @@
 import pytest
 import yaml
 
-from emopose.library import LibraryError
+from emopose.joint_limits import LibraryError
 from tests.conftest import REST, load_library, make_library_dir, write_motion
 
 

@@ -1,4 +1,6 @@
 from emopose.contract import GestureRecord, Plan
+from emopose.execution.sequencer import State
+from tests.wiring import wire
 
 
 def test_a_turn_joins_the_dialogue_history_and_the_next_turn_sees_it(wired):
@@ -6,8 +8,27 @@ def test_a_turn_joins_the_dialogue_history_and_the_next_turn_sees_it(wired):
     second = wired.runner.run("Look over there.")
     assert first.request.history == ()
     assert [m["content"] for m in second.request.history] == ["Welcome to the lab!", first.plan.reply]
-    assert len(wired.runner.history) == 4
-    assert wired.runner.run("No.", use_history=False).request.history == ()
+    assert len(wired.runner.dialogue.messages) == 4
+
+
+def test_a_prepared_answer_sees_the_question_and_the_caller_adds_what_was_said(wired):
+    wired.runner.dialogue.said("This is the lab.")
+    turn = wired.runner.run("Our students built it.", question="Who built that?", remember=False)
+    assert [(m["role"], m["content"]) for m in turn.request.history] == [
+        ("assistant", "This is the lab."), ("user", "Who built that?")]
+    assert wired.runner.dialogue.messages == [{"role": "assistant", "content": "This is the lab."}]
+
+
+def test_silence_stops_the_speech_and_clears_the_gestures(library, tmp_path):
+    wired = wire(library, tmp_path, until="none")  # returns once the gestures are queued (web UI, tour)
+    with wired.session:
+        wired.runner.run("Look over there, welcome!")
+        assert wired.sequencer.pending or wired.sequencer.active is not None
+        stopped = []
+        wired.player.stop = lambda: stopped.append(True)
+        wired.runner.silence()
+        assert stopped == [True] and not wired.sequencer.pending
+        assert wired.sequencer.state == State.BLENDING  # from where the arm is toward neutral
 
 
 def test_a_scripted_plan_enters_at_resolve_without_a_planner_call(wired):
@@ -23,7 +44,7 @@ def test_a_scripted_plan_enters_at_resolve_without_a_planner_call(wired):
     assert turn.planner_output is None and turn.plan is plan
     assert turn.resolved[0].entry.name == "pointing_b" and turn.resolved[0].rule == "exact"
     assert "parse" not in turn.stage_s and turn.dispatched.completed
-    assert wired.runner.history == []
+    assert wired.runner.dialogue.messages == []
 
 
 def test_the_session_opens_once_whoever_asks(wired):

@@ -1,5 +1,6 @@
 """Every sequencer transition with a fake clock, plus continuity and thread safety."""
 
+import json
 import threading
 
 import numpy as np
@@ -8,9 +9,10 @@ import pytest
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
 from emopose.execution.control_loop import ControlLoop
-from emopose.execution.gesture_command import GestureCommand
+from emopose.execution.gesture_command import EventKind, GestureCommand
 from emopose.execution.sequencer import Sequencer, State
 from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.sync.recording import event_message
 
 
 def command(library, name, release_at=float("-inf")):
@@ -57,7 +59,8 @@ def test_idle_to_executing_to_holding_then_neutral(library, rig, rest):
     loop.run_until(lambda: sequencer.state == State.IDLE, 10)
     states = [s[1] for s in stream]
     assert State.BLENDING in states[states.index(State.HOLDING):]
-    recovery_start = next(e.t for e in sequencer.events if e.kind == "state" and e.detail == "blending")
+    recovery_start = next(e.t for e in sequencer.events
+                          if e.kind == EventKind.STATE and e.detail == State.BLENDING)
     assert recovery_start - held_at == pytest.approx(2.0, abs=0.021)  # hold 2 s
     assert clock.now() - recovery_start == pytest.approx(1.0, abs=0.021)  # neutral in 1 s
     assert np.allclose(sequencer.last, library.neutral_entry.q[0])
@@ -77,7 +80,8 @@ def test_queue_order_and_blend_at_most_03s(library, rig):
     for name in ("welcoming_a", "pointing_b", "rejecting_a"):
         sequencer.submit(command(library, name))
     loop.run_until(sequencer.settled, 30)
-    assert [e.name for e in kinds(sequencer, "started")] == ["welcoming_a", "pointing_b", "rejecting_a"]
+    started = [e.name for e in kinds(sequencer, EventKind.STARTED)]
+    assert started == ["welcoming_a", "pointing_b", "rejecting_a"]
     blends = []
     for (t0, s0, _), (t1, s1, _) in zip(stream, stream[1:]):
         if s1 == State.BLENDING and s0 != State.BLENDING:
@@ -91,8 +95,8 @@ def test_queue_order_and_blend_at_most_03s(library, rig):
 def test_release_time_is_respected(library, rig):
     sequencer, loop, clock, stream = rig
     sequencer.submit(command(library, "pointing_a", release_at=clock.now() + 0.5))
-    loop.run_until(lambda: bool(kinds(sequencer, "started")), 5)
-    assert kinds(sequencer, "started")[0].t == pytest.approx(0.5, abs=0.02)
+    loop.run_until(lambda: bool(kinds(sequencer, EventKind.STARTED)), 5)
+    assert kinds(sequencer, EventKind.STARTED)[0].t == pytest.approx(0.5, abs=0.02)
 
 
 def test_holding_accepts_new_command_directly(library, rig):
@@ -115,11 +119,11 @@ def test_interrupt_clears_queue_and_blends_from_latest(library, rig):
     before = sequencer.last.copy()
     sequencer.interrupt([command(library, "comforting_b")], now=clock.now())
     assert sequencer.pending == [] and sequencer.state == State.BLENDING
-    assert kinds(sequencer, "stopped")[0].name == "welcoming_a"
+    assert kinds(sequencer, EventKind.STOPPED)[0].name == "welcoming_a"
     loop.tick()
     assert np.max(np.abs(sequencer.last - before)) <= library.limits.max_velocity.max() * 0.02
     loop.run_until(sequencer.settled, 10)
-    assert [e.name for e in kinds(sequencer, "started")] == ["welcoming_a", "comforting_b"]
+    assert [e.name for e in kinds(sequencer, EventKind.STARTED)] == ["welcoming_a", "comforting_b"]
     assert_continuous(stream, library)
 
 
@@ -140,7 +144,8 @@ def test_unsafe_candidate_rejected_with_reason(library, rest):
     sequencer.submit(command(library, "pointing_a"))
     sequencer.step(0.0)
     assert sequencer.state == State.IDLE
-    assert sequencer.events.recent(1)[0].kind == "rejected" and "torso" in sequencer.events.recent(1)[0].detail
+    last = sequencer.events.recent(1)[0]
+    assert last.kind == EventKind.REJECTED and "torso" in last.detail
 
 
 def test_submit_and_interrupt_are_thread_safe(library, rig):
@@ -174,9 +179,20 @@ def test_overdue_successor_preempts_only_when_enabled(library, rest):
         sequencer.submit(command(library, "pointing_a"))  # 1 s long
         sequencer.submit(command(library, "welcoming_b", release_at=0.3))
         loop.run_until(sequencer.settled, 10)
-        started = {e.name: e.t for e in kinds(sequencer, "started")}
-        assert bool(kinds(sequencer, "stopped")) == expect_stop
+        started = {e.name: e.t for e in kinds(sequencer, EventKind.STARTED)}
+        assert bool(kinds(sequencer, EventKind.STOPPED)) == expect_stop
         if expect_stop:
             assert started["welcoming_b"] <= 0.3 + 0.1 + 0.3 + 0.02  # overdue by 0.1 s, then a <= 0.3 s blend
         else:
             assert started["welcoming_b"] >= 1.0
+
+
+def test_event_kinds_are_enums_and_recorded_as_their_strings(library, rig):
+    sequencer, loop, _, _ = rig
+    sequencer.submit(command(library, "welcoming_a"))
+    loop.run_until(lambda: sequencer.state == State.IDLE and bool(kinds(sequencer, EventKind.COMPLETED)), 20)
+    assert {type(e.kind) for e in sequencer.events} == {EventKind}
+    assert [e.kind for e in sequencer.events if e.kind != EventKind.STATE] == [
+        EventKind.STARTED, EventKind.COMPLETED]
+    recorded = json.dumps(event_message(kinds(sequencer, EventKind.STARTED)[0], 0.0))  # as in session.mcap
+    assert json.loads(recorded)["kind"] == "started" and type(json.loads(recorded)["kind"]) is str

@@ -26,4 +26,5 @@ def test_dropped_and_unarrived_strokes_count_against_the_share_but_not_the_stati
     summary = stroke_summary(rows)
     assert summary["n"] == 4 and summary["arrived"] == 2
     assert summary["within_window_share"] == 0.5 and summary["dropped_share"] == 0.25
-    assert summary["median_abs_ms"] == pytest.approx(40.0) and summary["median_signed_ms"] == pytest.approx(-10.0)
+    assert (summary["median_abs_ms"] == pytest.approx(40.0)
+            and summary["median_signed_ms"] == pytest.approx(-10.0))

@@ -91,7 +91,8 @@ def test_every_segment_respects_the_speed_bound_and_the_scale_bounds(g1):
     rng = np.random.default_rng(3)
     names = [n for n in g1.names if g1.get(n).motion_type == "sequence"]
     for _ in range(60):
-        chosen = [gesture(g1, str(rng.choice(names)), int(rng.integers(1, 6))) for _ in range(rng.integers(1, 5))]
+        chosen = [gesture(g1, str(rng.choice(names)), int(rng.integers(1, 6)))
+                  for _ in range(rng.integers(1, 5))]
         onsets = np.sort(rng.uniform(0.0, 6.0, len(chosen))).tolist()
         timings, preroll = planner(g1).plan(chosen, onsets)
         assert 0.0 <= preroll <= 0.4 + 1e-9

@@ -19,8 +19,8 @@ from emopose.turn.model import Release
 from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 from tests.core.conftest import gesture
 
-NAMES = ("point_forward_right", "palm_stop", "chop_right", "face_wave", "shrug", "open_arms", "beat_both_hands",
-         "point_up", "wave_off", "calm_down_palms")
+NAMES = ("point_forward_right", "palm_stop", "chop_right", "face_wave", "shrug", "open_arms",
+         "beat_both_hands", "point_up", "wave_off", "calm_down_palms")
 
 
 class Rig:
@@ -44,7 +44,8 @@ class Rig:
         timings, _ = planner.plan(gestures, onsets)
         releases = tuple(Release(t.times[0], "words", True, timing=t) if not isinstance(t, str)
                          else Release(0.0, "words", True, dropped=t) for t in timings)
-        commands = [SequenceStage._command(k, g, r, speech_start) for k, (g, r) in enumerate(zip(gestures, releases))]
+        commands = [SequenceStage._command(k, g, r, speech_start)
+                    for k, (g, r) in enumerate(zip(gestures, releases))]
         return sorted(zip(commands, releases), key=lambda p: p[0].release_at)
 
     def submit(self, gestures, onsets, speech_start: float) -> list[GestureCommand]:
@@ -83,7 +84,8 @@ def test_a_timed_command_reaches_its_stroke_keyframe_at_the_planned_time(g1):
 
 def test_coarticulated_gestures_go_from_stroke_to_stroke_without_rest(g1):
     rig = Rig(g1)
-    first, second = rig.submit([gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")], [1.0, 2.6], 0.0)
+    first, second = rig.submit([gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")],
+                               [1.0, 2.6], 0.0)
     assert first.cut and second.blend_in
     rig.run(6.0)
     assert [e.name for e in rig.events("cut")] == ["point_forward_right"]
@@ -164,7 +166,8 @@ def test_a_reply_whose_triggers_are_missing_still_gets_a_timeline(g1, tmp_path):
     records = [GestureRecord(cls="welcoming", variant="face_wave", trigger="not said"),
                GestureRecord(cls="pointing", variant="point_left", trigger="nor this")]
     with wired.session:
-        turn = wired.runner.run_plan(Plan.scripted("Good morning, the tour starts in five minutes.", *records))
+        turn = wired.runner.run_plan(Plan.scripted("Good morning, the tour starts in five minutes.",
+                                                   *records))
     releases = turn.schedule.releases
     assert [r.how for r in releases] == ["even", "even"] and not any(r.trigger_found for r in releases)
     assert all(r.timing is not None for r in releases)  # placed on the anchor equation's even spacing

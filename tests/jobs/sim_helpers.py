@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import os
 
-from tests.conftest import compose_config, synthetic_library  # noqa: F401 -- re-exported for tests/jobs, tests/tour
+# re-exported for tests/jobs, tests/tour
+from tests.conftest import compose_config, synthetic_library  # noqa: F401
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # before the first mujoco import
 

@@ -37,14 +37,15 @@ def test_library_check_two_g1_motions(tmp_path):
 
 def test_library_check_reports_a_self_contact(tmp_path):
     library = synthetic_library(tmp_path / "library")
-    write_motion(tmp_path / "library", "hand_in_chest", "comforting", [REST, HAND_IN_CHEST, HAND_IN_CHEST, REST],
-                 duration=2.0)
-    overrides = ["+experiment=library_check", "job.motions=[hand_in_chest,neutral_rest]", "job.intensities=[1,3]",
-                 "job.sheets=false", *library]
+    write_motion(tmp_path / "library", "hand_in_chest", "comforting",
+                 [REST, HAND_IN_CHEST, HAND_IN_CHEST, REST], duration=2.0)
+    overrides = ["+experiment=library_check", "job.motions=[hand_in_chest,neutral_rest]",
+                 "job.intensities=[1,3]", "job.sheets=false", *library]
     results = run(compose_config(overrides), tmp_path / "run")
     motion = results["per_motion"]["hand_in_chest"]
     assert 3 in motion["contact_levels"], motion["contact_pairs"]
-    assert any("left_hand" in pair and ("chest" in pair or "abdomen" in pair) for pair in motion["contact_pairs"])
+    assert any("left_hand" in pair and ("chest" in pair or "abdomen" in pair)
+               for pair in motion["contact_pairs"])
     contact = next(iter(motion["levels"]["3"]["contacts"].values()))
     assert 0 < contact["first_t"] <= contact["last_t"] and contact["ticks"] >= 1
     assert 3 in motion["rejected_levels"]  # the capsule heuristic refuses it before dispatch too

@@ -16,7 +16,8 @@ from tests.jobs.sim_helpers import compose_config, synthetic_library
 @pytest.mark.parametrize("text, match", [
     (None, "does not exist"),
     ("<mujoco><worldbody><body></worldbody></mujoco>", "cannot be loaded"),
-    ('<mujoco><worldbody><geom type="sphere" size="-1"/></worldbody></mujoco>', "cannot be loaded|does not compile"),
+    ('<mujoco><worldbody><geom type="sphere" size="-1"/></worldbody></mujoco>',
+     "cannot be loaded|does not compile"),
     ('<mujoco><worldbody><geom type="sphere" size="0.1"/></worldbody></mujoco>', "lacks the joint"),
 ])
 def test_build_model_names_the_file(tmp_path, text, match):
@@ -29,7 +30,8 @@ def test_build_model_names_the_file(tmp_path, text, match):
 
 
 def test_sim_suite_with_a_missing_model(tmp_path):
-    cfg = compose_config(["+experiment=sim_suite", "trials=8", f"backend.model_path={tmp_path / 'absent.xml'}",
+    cfg = compose_config(["+experiment=sim_suite", "trials=8",
+                          f"backend.model_path={tmp_path / 'absent.xml'}",
                           *synthetic_library(tmp_path / "library")])
     with pytest.raises(ModelError, match="backend.model_path"):
         run(cfg, tmp_path / "run")

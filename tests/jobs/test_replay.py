@@ -41,7 +41,8 @@ def test_command_grid_holds_across_gaps_and_drops_duplicates():
     assert commands[:, 0].tolist() == [0, 0, 0, 1, 2]
 
 
-@pytest.mark.parametrize("mcap, match", [("null", "needs mcap=PATH"), ("/no/such/session.mcap", "does not exist")])
+@pytest.mark.parametrize("mcap, match", [("null", "needs mcap=PATH"),
+                                         ("/no/such/session.mcap", "does not exist")])
 def test_replay_needs_an_existing_recording(mcap, match, tmp_path):
     with pytest.raises(ConfigError, match=match):
         run(compose_config(["+experiment=replay", f"mcap={mcap}"]), tmp_path)

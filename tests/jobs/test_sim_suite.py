@@ -10,10 +10,11 @@ import pytest
 from emopose import CLASSES, CONTROL_DT
 from emopose.app import run
 from emopose.backends.mujoco import MujocoBackend
+from emopose.backends.stream_tap import StreamTap
 from emopose.build import make
 from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.jobs.sim_suite import SimSuiteJob
-from emopose.jobs.tracking import StreamTap, tracking_error
+from emopose.jobs.tracking import tracking_error
 from emopose.recording import read_recording
 from tests.jobs.sim_helpers import compose_config
 
@@ -72,7 +73,8 @@ def test_sim_suite_eight_trials_end_to_end(tmp_path):
     assert len(streams["/joints/sim"]) > 8 * 50 and "/plan" in streams
 
 
-@pytest.mark.parametrize("kwargs, match", [({"trials": 12}, "multiple of 8"), ({"start_from": "zero"}, "start_from"),
+@pytest.mark.parametrize("kwargs, match", [({"trials": 12}, "multiple of 8"),
+                                           ({"start_from": "zero"}, "start_from"),
                                            ({"intensity": 6}, "intensity")])
 def test_sim_suite_rejects_bad_settings(kwargs, match):
     with pytest.raises(ValueError, match=match):

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from emopose.backends.dry_run import DryRunBackend
-from emopose.jobs.tracking import StreamTap, latency_ms, resample, sim_mae, tracking_error
+from emopose.backends.stream_tap import StreamTap
+from emopose.jobs.tracking import latency_ms, resample, sim_mae, tracking_error
 
 
 def test_resample_keeps_endpoints_and_is_linear():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+import inspect
 import json
 import sys
 from collections.abc import Callable, Iterator
@@ -46,7 +48,8 @@ def fake_openai() -> Iterator[FakeOpenAI]:
 
 @pytest.fixture
 def planner_kwargs(fake_openai: FakeOpenAI, demonstrations_file: Path, tmp_path: Path) -> dict:
-    """Settings for a planner talking to the fake server, with a private cache and near-zero backoff."""
+    """Settings for a planner talking to the fake server, with a private cache and near-zero backoff (the
+    client's and the planner's together: make_chat sorts them)."""
     return {"model": "openai/fake-model", "api_base": fake_openai.url, "temperature": 0.7,
             "timeout_s": 5.0, "max_retries": 3, "backoff_s": 0.001, "backoff_max_s": 0.01,
             "cache": True, "cache_dir": str(tmp_path / "llm-cache"),
@@ -54,22 +57,33 @@ def planner_kwargs(fake_openai: FakeOpenAI, demonstrations_file: Path, tmp_path:
 
 
 @pytest.fixture
-def make_llm_planner(writable_library, planner_kwargs) -> Callable:
-    from emopose.planners.chat.llm import LLMPlanner
+def make_chat(writable_library, planner_kwargs) -> Callable:
+    """make_chat(Class, template, **settings): a chat planner whose LLMClient takes the settings it names
+    (planner.client.* in the config) and whose constructor takes the rest, plus the library if it asks."""
+    from emopose.llm.client import LLMClient
 
-    def make(**overrides):
-        kwargs = {**planner_kwargs, "template": str(PROJECT_ROOT / "prompts/structured.md"), **overrides}
-        return LLMPlanner(library=writable_library, **kwargs)
+    client_keys = set(inspect.signature(LLMClient).parameters)
+
+    def make(cls, template: str, **overrides):
+        settings = {**planner_kwargs, "template": str(PROJECT_ROOT / template), **overrides}
+        client = LLMClient(**{k: v for k, v in settings.items() if k in client_keys})
+        own = {k: v for k, v in settings.items() if k not in client_keys}
+        if "library" in inspect.signature(cls).parameters:
+            own["library"] = writable_library
+        return cls(client=client, **own)
 
     return make
 
 
 @pytest.fixture
-def make_label_planner(writable_library, planner_kwargs) -> Callable:
+def make_llm_planner(make_chat) -> Callable:
+    from emopose.planners.chat.llm import LLMPlanner
+
+    return functools.partial(make_chat, LLMPlanner, "prompts/structured.md")
+
+
+@pytest.fixture
+def make_label_planner(make_chat) -> Callable:
     from emopose.planners.chat.direct_label import DirectLabelPlanner
 
-    def make(**overrides):
-        kwargs = {**planner_kwargs, "template": str(PROJECT_ROOT / "prompts/direct_label.md"), **overrides}
-        return DirectLabelPlanner(library=writable_library, **kwargs)
-
-    return make
+    return functools.partial(make_chat, DirectLabelPlanner, "prompts/direct_label.md")

@@ -44,7 +44,8 @@ def ok(content: str = PLAN_JSON, delay_s: float = 0.0) -> Answer:
 
 
 def malformed() -> Answer:
-    return Answer(content='{"reply": "Sure", "gestures": [{"class": "agreeing", intensity: high}', kind="malformed")
+    return Answer(content='{"reply": "Sure", "gestures": [{"class": "agreeing", intensity: high}',
+                  kind="malformed")
 
 
 def empty() -> Answer:
@@ -107,7 +108,8 @@ FAULTS: dict[str, Callable[[str], Answer]] = {
 
 
 def faulty(delay_s: float, bad_rate: float, seed: int = 0, mix: tuple[str, ...] = ("malformed", "http_500"),
-           slow_s: float = 0.0, good: Callable[[dict], str] = lambda body: PLAN_JSON) -> Callable[[dict, int], Answer]:
+           slow_s: float = 0.0,
+           good: Callable[[dict], str] = lambda body: PLAN_JSON) -> Callable[[dict, int], Answer]:
     """A default for load tests: every answer after delay_s; bad_rate of them drawn evenly from `mix`
     (names in FAULTS), per request (so a retried 500 draws again), from a seeded generator. A bad answer
     also waits `slow_s` more (the issue's 3 s delays). `good(body)` is the right plan for a request; a

@@ -72,8 +72,9 @@ def context_overflow(window: int) -> Callable[[dict], Answer | None]:
 class FakeOpenAI:
     """The server; use as a context manager, or start()/stop()."""
 
-    def __init__(self, default: Answer | Callable[[dict, int], Answer] | None = None, api_key: str | None = None,
-                 models: tuple[str, ...] | None = None, context_window: int | None = None) -> None:
+    def __init__(self, default: Answer | Callable[[dict, int], Answer] | None = None,
+                 api_key: str | None = None, models: tuple[str, ...] | None = None,
+                 context_window: int | None = None) -> None:
         """`api_key`: 401 without it; `models`: 404 for any other model; `context_window`: 400 above it."""
         self.default = default or ok()
         self.api_key, self.models = api_key, models
@@ -82,12 +83,12 @@ class FakeOpenAI:
         self.paths: list[str] = []
         self.served: Counter[str] = Counter()  # answer kinds sent, e.g. {"ok": 9, "http_500": 1}
         self.in_progress = self.peak = self.answered = 0
-        self.tokens_sent = self.streams_dropped = 0  # streaming: tokens written; streams the client closed early
+        self.tokens_sent = self.streams_dropped = 0  # streaming: tokens written; streams closed early
         self._script: deque[Answer] = deque()
         self._lock = threading.Lock()
         self._stopping = threading.Event()
         self._connections: set[socket.socket] = set()  # open keep-alive connections, closed by stop()
-        self._server = ThreadingHTTPServer(("127.0.0.1", 0), self._handler_class())
+        self._server = ThreadingHTTPServer(("127.0.0.1", 0), type("Handler", (_Handler,), {"fake": self}))
         self._server.daemon_threads = True
         self._thread = threading.Thread(target=self._server.serve_forever, kwargs={"poll_interval": 0.02},
                                         daemon=True)
@@ -132,7 +133,8 @@ class FakeOpenAI:
         if self.api_key and authorization != f"Bearer {self.api_key}":
             return http_error(401, "Incorrect API key provided.")
         if self.models is not None and body.get("model") not in self.models:
-            return http_error(404, f"The model `{body.get('model')}` does not exist or you do not have access to it.")
+            return http_error(404, f"The model `{body.get('model')}` does not exist or you do not have "
+                                   "access to it.")
         return self.gate(body) if self.gate else None
 
     def _next_answer(self, body: dict, path: str, authorization: str | None = None) -> Answer:
@@ -144,7 +146,8 @@ class FakeOpenAI:
             self.requests.append(body)
             self.paths.append(path)
             scripted = None if refusal or not self._script else self._script.popleft()
-        answer = refusal or scripted or (self.default(body, index) if callable(self.default) else self.default)
+        default = self.default(body, index) if callable(self.default) else self.default
+        answer = refusal or scripted or default
         with self._lock:
             self.served[answer.kind] += 1
         return answer
@@ -158,63 +161,62 @@ class FakeOpenAI:
         with self._lock:
             return {"requests": len(self.requests), "served": dict(self.served)}
 
-    def _handler_class(self) -> type[BaseHTTPRequestHandler]:
-        server = self
+class _Handler(BaseHTTPRequestHandler):
+    """One connection to `fake` (the FakeOpenAI whose server made it)."""
 
-        class Handler(BaseHTTPRequestHandler):
-            protocol_version = "HTTP/1.1"  # keep-alive, as real providers do
+    fake: FakeOpenAI
+    protocol_version = "HTTP/1.1"  # keep-alive, as real providers do
 
-            def setup(self) -> None:
-                super().setup()
-                with server._lock:
-                    server._connections.add(self.connection)
+    def setup(self) -> None:
+        super().setup()
+        with self.fake._lock:
+            self.fake._connections.add(self.connection)
 
-            def log_message(self, *args: object) -> None:  # keep test output quiet
-                pass
+    def log_message(self, *args: object) -> None:  # keep test output quiet
+        pass
 
-            def do_GET(self) -> None:
-                if self.path == "/stats":  # for a server in another process (the load benchmark)
-                    self._send(200, server.stats())
-                else:
-                    self._send(404, {"error": {"message": f"no route {self.path}"}})
+    def do_GET(self) -> None:
+        if self.path == "/stats":  # for a server in another process (the load benchmark)
+            self._send(200, self.fake.stats())
+        else:
+            self._send(404, {"error": {"message": f"no route {self.path}"}})
 
-            def do_POST(self) -> None:
-                raw = self.rfile.read(int(self.headers.get("Content-Length", 0)))
-                if self.path.split("?")[0] not in CHAT_PATHS:
-                    self._send(404, {"error": {"message": f"no route {self.path}"}})
-                    return
-                try:
-                    body = json.loads(raw)
-                except json.JSONDecodeError:
-                    self._send(400, {"error": {"message": "request body is not JSON"}})
-                    return
-                answer = server._next_answer(body, self.path, self.headers.get("Authorization"))
-                delay_s = answer.delay_s + (0.0 if body.get("stream") else generation_s(answer))
-                if delay_s and server._stopping.wait(delay_s):
-                    sent = False  # the server is shutting down
-                elif answer.status != 200:
-                    sent = self._send(answer.status, _error_body(answer.status, answer.message), answer.headers)
-                elif body.get("stream"):
-                    sent = send_stream(self, answer, body.get("model", ""), server)
-                else:
-                    sent = self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
-                server._done(sent)
+    def do_POST(self) -> None:
+        raw = self.rfile.read(int(self.headers.get("Content-Length", 0)))
+        if self.path.split("?")[0] not in CHAT_PATHS:
+            self._send(404, {"error": {"message": f"no route {self.path}"}})
+            return
+        try:
+            body = json.loads(raw)
+        except json.JSONDecodeError:
+            self._send(400, {"error": {"message": "request body is not JSON"}})
+            return
+        answer = self.fake._next_answer(body, self.path, self.headers.get("Authorization"))
+        delay_s = answer.delay_s + (0.0 if body.get("stream") else generation_s(answer))
+        if delay_s and self.fake._stopping.wait(delay_s):
+            sent = False  # the server is shutting down
+        elif answer.status != 200:
+            sent = self._send(answer.status, _error_body(answer.status, answer.message),
+                              answer.headers)
+        elif body.get("stream"):
+            sent = send_stream(self, answer, body.get("model", ""), self.fake)
+        else:
+            sent = self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
+        self.fake._done(sent)
 
-            def _send(self, status: int, payload: dict, headers: dict | None = None) -> bool:
-                data = json.dumps(payload).encode()
-                try:
-                    self.send_response(status)
-                    self.send_header("Content-Type", "application/json")
-                    self.send_header("Content-Length", str(len(data)))
-                    for key, value in (headers or {}).items():
-                        self.send_header(key, value)
-                    self.end_headers()
-                    self.wfile.write(data)
-                except (BrokenPipeError, ConnectionResetError):
-                    return False  # the client gave up (a timeout test); nothing to tell it
-                return True
-
-        return Handler
+    def _send(self, status: int, payload: dict, headers: dict | None = None) -> bool:
+        data = json.dumps(payload).encode()
+        try:
+            self.send_response(status)
+            self.send_header("Content-Type", "application/json")
+            self.send_header("Content-Length", str(len(data)))
+            for key, value in (headers or {}).items():
+                self.send_header(key, value)
+            self.end_headers()
+            self.wfile.write(data)
+        except (BrokenPipeError, ConnectionResetError):
+            return False  # the client gave up (a timeout test); nothing to tell it
+        return True
 
 
 def main() -> None:
@@ -229,12 +231,14 @@ def main() -> None:
     parser.add_argument("--api-key", default=None)
     parser.add_argument("--models", nargs="*", default=None)
     parser.add_argument("--context-window", type=int, default=None)
-    parser.add_argument("--reply", default=None, help="answer with this text ({n}: the request's number), paced")
+    parser.add_argument("--reply", default=None,
+                        help="answer with this text ({n}: the request's number), paced")
     parser.add_argument("--first-token-s", type=float, default=0.0)
     parser.add_argument("--tokens-per-s", type=float, default=0.0)
     args = parser.parse_args()
     default = (faulty(args.delay, args.bad_rate, args.seed, tuple(args.mix), args.slow) if args.reply is None
-               else lambda body, n: streamed(args.reply.replace("{n}", str(n)), args.first_token_s, args.tokens_per_s))
+               else lambda body, n: streamed(args.reply.replace("{n}", str(n)), args.first_token_s,
+                                             args.tokens_per_s))
     with FakeOpenAI(default, args.api_key, args.models and tuple(args.models), args.context_window) as server:
         print(json.dumps({"url": server.url}), flush=True)
         sys.stdin.read()

@@ -8,23 +8,21 @@ import functools
 import pytest
 from fake_answers import http_error, ok
 
-from emopose.config import PROJECT_ROOT
 from emopose.planners.base import PlanRequest
 from emopose.planners.baselines.keyword import KeywordPlanner
-from emopose.planners.chat.annotate import AnnotatePlanner
+from emopose.planners.chat.annotate import AnnotatePlanner, built_annotator
 from emopose.stages.parse import parse_output
 
-QUESTION = PlanRequest("Where can I charge my phone?", history=({"role": "user", "content": "Hi!"},
-                                                                  {"role": "assistant", "content": "Welcome!"}))
+GREETING = ({"role": "user", "content": "Hi!"}, {"role": "assistant", "content": "Welcome!"})
+QUESTION = PlanRequest("Where can I charge my phone?", history=GREETING)
 SPOKEN = "Sure!  The charging dock is over there,\nby the window. No, don't use the lab sockets."
 
 
 @pytest.fixture
-def make_annotate(writable_library, planner_kwargs):
+def make_annotate(make_chat):
     def make(**overrides):
-        kwargs = {**planner_kwargs, "template": str(PROJECT_ROOT / "prompts/annotate.md"),
-                  "annotator": KeywordPlanner(), **overrides}
-        return AnnotatePlanner(library=writable_library, **kwargs)
+        settings = {"annotator": KeywordPlanner(), **overrides}
+        return make_chat(AnnotatePlanner, "prompts/annotate.md", **settings)
 
     return make
 
@@ -34,7 +32,8 @@ def test_the_reply_is_the_models_words_and_every_trigger_is_in_it(fake_openai, m
     plan = parse_output(make_annotate().plan(QUESTION), QUESTION.utterance)
     reply = " ".join(SPOKEN.split())
     assert plan.source == "model" and plan.reply == reply
-    assert plan.records == parse_output(KeywordPlanner().plan(PlanRequest(reply))).records  # the annotator's plan
+    annotated = parse_output(KeywordPlanner().plan(PlanRequest(reply))).records
+    assert plan.records == annotated  # the annotator's plan
     assert {"pointing", "rejecting"} <= {r.cls for r in plan.records}
     assert all(r.trigger and r.trigger in reply for r in plan.records)  # say-do holds by construction
     body = fake_openai.requests[0]
@@ -70,7 +69,23 @@ def test_no_reply_is_a_counted_fallback(fake_openai, make_annotate, answer, sour
     assert plan.source == source and plan.fallback
 
 
-def test_the_preset_composes_with_the_local_annotator(compose):
+def test_a_factory_is_given_the_library_only_when_its_planner_asks(writable_library):
+    given = []
+
+    def annotator(library):
+        given.append(library)
+        return KeywordPlanner()
+
+    assert isinstance(built_annotator(annotator, writable_library), KeywordPlanner)
+    assert given == [writable_library]
+    assert isinstance(built_annotator(functools.partial(KeywordPlanner, max_records=2), writable_library),
+                      KeywordPlanner)  # it takes no library: none is forced on it
+
+
+def test_the_preset_composes_with_the_local_annotator_and_the_hosted_client(compose):
     planner = compose("planner=annotate").planner
-    assert planner.annotator._target_ == "emopose.planners.local.planner.LocalPlanner" and planner.annotator._partial_
+    assert planner.annotator._target_ == "emopose.planners.local.planner.LocalPlanner.from_config"
+    assert planner.annotator._partial_
     assert planner.mode == "respond" and planner.template.endswith("prompts/annotate.md")
+    assert planner.client._target_ == "emopose.llm.client.LLMClient"
+    assert planner.client.max_tokens == 256  # a few spoken sentences; the rest as conf/llm/hosted.yaml

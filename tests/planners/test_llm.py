@@ -36,7 +36,8 @@ def test_good_answer_is_returned_raw(fake_openai, make_llm_planner):
     assert fake_openai.paths == ["/v1/chat/completions"]
 
 
-@pytest.mark.parametrize("failures", [[http_error(500)], [http_error(502), http_error(503)], [rate_limited()]])
+@pytest.mark.parametrize("failures", [[http_error(500)], [http_error(502), http_error(503)],
+                                      [rate_limited()]])
 def test_transient_errors_are_retried(fake_openai, make_llm_planner, failures):
     fake_openai.script(*failures, ok())
     planner = make_llm_planner()
@@ -96,13 +97,13 @@ def test_each_pass_is_its_own_draw_when_sampling(fake_openai, make_llm_planner):
     sampled = make_llm_planner(temperature=0.7)
     assert sampled.sampled
     for k in (0, 1):
-        sampled.pass_index = k  # what a bench job does before pass k
+        sampled.client.pass_index = k  # what a suite job does before pass k
         sampled.plan(WELCOME)
     assert fake_openai.count == 2
 
     rerun = make_llm_planner(temperature=0.7)  # a rerun (new process) replays both passes
     for k in (0, 1):
-        rerun.pass_index = k
+        rerun.client.pass_index = k
         assert rerun.plan(WELCOME).meta["cached"]
     assert fake_openai.count == 2
 
@@ -116,7 +117,7 @@ def test_greedy_decoding_shares_one_answer_across_passes(fake_openai, make_llm_p
     greedy = make_llm_planner(temperature=0.0)
     assert not greedy.sampled
     for k in range(3):
-        greedy.pass_index = k
+        greedy.client.pass_index = k
         greedy.plan(WELCOME)
     assert fake_openai.count == 1
 
@@ -157,7 +158,8 @@ def test_request_carries_the_live_library_guide(fake_openai, make_llm_planner, w
 
 
 def test_request_carries_history_and_image(fake_openai, make_llm_planner, tmp_path):
-    history = ({"role": "user", "content": "Where is my bag?"}, {"role": "assistant", "content": "Which bag?"})
+    history = ({"role": "user", "content": "Where is my bag?"},
+               {"role": "assistant", "content": "Which bag?"})
     png = b"\x89PNG\r\n\x1a\n" + b"0" * 32
     make_llm_planner().plan(PlanRequest("The blue one, on the chair.", history=history, image=png))
     messages = fake_openai.requests[0]["messages"]
@@ -165,12 +167,14 @@ def test_request_carries_history_and_image(fake_openai, make_llm_planner, tmp_pa
     assert messages[1]["content"] == "Where is my bag?" and messages[2]["content"] == "Which bag?"
     text, image = messages[3]["content"]
     assert text == {"type": "text", "text": "The blue one, on the chair."}
-    assert image["type"] == "image_url" and image["image_url"]["url"].startswith("data:image/png;base64,iVBOR")
+    assert image["type"] == "image_url"
+    assert image["image_url"]["url"].startswith("data:image/png;base64,iVBOR")
 
     photo = tmp_path / "frame.jpg"
     photo.write_bytes(b"\xff\xd8\xff" + b"1" * 16)
     make_llm_planner().plan(PlanRequest("What is that?", image=str(photo)))
-    assert fake_openai.requests[1]["messages"][-1]["content"][1]["image_url"]["url"].startswith("data:image/jpeg")
+    sent = fake_openai.requests[1]["messages"][-1]["content"][1]
+    assert sent["image_url"]["url"].startswith("data:image/jpeg")
 
 
 def test_unreadable_image_falls_back(fake_openai, make_llm_planner, tmp_path):

@@ -55,7 +55,8 @@ def test_the_parse_stage_never_calls_a_failed_call_the_model(fake_openai, make_l
     turn = Turn(WELCOME, planner_output=make_llm_planner(max_retries=0).plan(WELCOME))
     plan = Parse()(turn)
     assert plan.source == "call_failed" and plan.fallback
-    assert plan.records[0].cls == "welcoming" and "InternalServerError" in plan.notes[-1]  # the keyword rules'
+    assert plan.records[0].cls == "welcoming"  # the keyword rules'
+    assert "InternalServerError" in plan.notes[-1]
 
 
 @pytest.mark.parametrize("mode,spoken", [("narrate", WELCOME.utterance), ("respond", plain().content)])
@@ -84,12 +85,15 @@ def test_a_faulty_server_is_counted_answer_by_answer(compose, tmp_path, demonstr
     with FakeOpenAI(faulty(0.0, 0.3, seed=3, mix=mix, good=_label_of(items))) as server:
         cfg = compose("+experiment=bench_all", "planner=llm", f"bench.path={BENCH}", "job.progress=false",
                       "job.confusion=false", "run.record=false", f"job.max_fallback_share={limit}",
-                      "planner.model=openai/fake-model", f"planner.api_base={server.url}", "planner.temperature=0",
-                      "planner.cache=false", "planner.backoff_s=0.001", "planner.concurrency=1",  # one order: seeded draws
+                      "planner.client.model=openai/fake-model", f"planner.client.api_base={server.url}",
+                      "planner.client.temperature=0", "planner.client.cache=false",
+                      "planner.client.backoff_s=0.001",
+                      "planner.client.concurrency=1",  # one order: seeded draws
                       f"planner.demonstrations={demonstrations_file}",
                       *synthetic_library(tmp_path / "library"))
         if fails:
-            with pytest.raises(PlannerFailure, match=r"fell back on \d+ answers .*> job.max_fallback_share 10 %"):
+            with pytest.raises(PlannerFailure,
+                               match=r"fell back on \d+ answers .*> job.max_fallback_share 10 %"):
                 run(cfg, tmp_path / "run")
         else:
             run(cfg, tmp_path / "run")
@@ -100,7 +104,8 @@ def test_a_faulty_server_is_counted_answer_by_answer(compose, tmp_path, demonstr
     sources = [p["source"] for p in results["predictions"]]
     assert results["sources"] == {s: sources.count(s) for s in set(sources)}
     assert sources.count("retried") <= served["http_500"]  # a retry may draw another fault, or another 500
-    harmful = sum(p["source"] not in ("model", "retried") and p["pred"] != p["label"] for p in results["predictions"])
+    harmful = sum(p["source"] not in ("model", "retried") and p["pred"] != p["label"]
+                  for p in results["predictions"])
     assert results["accuracy"]["overall"]["mean"] == pytest.approx(100 * (1 - harmful / results["n"]))
     assert ("FALLBACKS" in (tmp_path / "run" / "results.md").read_text()) == fails
 
@@ -109,8 +114,9 @@ def test_the_plan_job_reports_the_true_source(compose, tmp_path, demonstrations_
     with FakeOpenAI() as server:
         server.script(ok(), http_error(500))  # the probe passes, the turn's call fails
         cfg = compose("+experiment=plan", "planner=llm", "utterance=Welcome aboard", "run.record=false",
-                      "planner.model=openai/fake-model", f"planner.api_base={server.url}", "planner.max_retries=0",
-                      "planner.cache=false", f"planner.demonstrations={demonstrations_file}",
+                      "planner.client.model=openai/fake-model", f"planner.client.api_base={server.url}",
+                      "planner.client.max_retries=0", "planner.client.cache=false",
+                      f"planner.demonstrations={demonstrations_file}",
                       *synthetic_library(tmp_path / "library"))
         results = run(cfg, tmp_path / "run")
     assert results["plan_source"] == "call_failed" and "plan from call_failed" in capsys.readouterr().out

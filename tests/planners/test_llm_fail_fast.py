@@ -23,7 +23,7 @@ def dead_url() -> str:
 
 def test_a_dead_endpoint_is_named(make_llm_planner):
     url = dead_url()
-    with pytest.raises(LLMConfigError, match=f"nothing answers at {url}.*planner.api_base"):
+    with pytest.raises(LLMConfigError, match=f"nothing answers at {url}.*planner.client.api_base"):
         make_llm_planner(api_base=url).check()
 
 
@@ -49,8 +49,8 @@ def test_a_server_side_context_overflow_is_named(make_llm_planner):
 
 
 def test_a_configured_window_is_checked_without_a_request(fake_openai, make_llm_planner):
-    with pytest.raises(LLMConfigError, match=r"prompt \(\d+ tokens\) plus planner.max_tokens \(1024\) exceeds "
-                                             r"openai/fake-model's context window of 2048 tokens"):
+    with pytest.raises(LLMConfigError, match=r"prompt \(\d+ tokens\) plus planner.client.max_tokens \(1024\) "
+                                             r"exceeds openai/fake-model's context window of 2048 tokens"):
         make_llm_planner(context_window=2048).check()
     assert fake_openai.count == 0
     make_llm_planner(context_window=8192).check()
@@ -62,7 +62,7 @@ def test_the_probe_is_one_real_request_and_no_item(fake_openai, make_llm_planner
     body = fake_openai.requests[0]
     assert fake_openai.count == 1 and body["max_tokens"] == 1
     assert body["messages"][0]["content"] == planner.system_prompt()  # a real prompt: overflow shows here
-    assert planner.stats()["calls"] == 0 and not (tmp_path / "llm-cache").exists()  # neither counted nor cached
+    assert planner.stats()["calls"] == 0 and not (tmp_path / "llm-cache").exists()  # not counted, not cached
     make_llm_planner(api_base=dead_url(), probe=False).check()  # replaying from the cache: no probe
 
 

@@ -40,7 +40,8 @@ def test_multi_act_items_assign_every_segment_to_an_annotated_act():
 def test_synthetic_sequences_join_items_of_different_classes():
     singles = [single_act(f"s{k}", text, label) for k, (text, label) in enumerate([
         ("Welcome aboard, everyone.", "welcoming"), ("The lifejackets are under your seat.", "pointing"),
-        ("Please don't lean over the rail!", "rejecting"), ("I'm not convinced the fog will lift.", "doubting")])]
+        ("Please don't lean over the rail!", "rejecting"),
+        ("I'm not convinced the fog will lift.", "doubting")])]
     joined = synthetic_sequences(singles, 40, seed=3)
     assert len(joined) >= 30
     for example in joined:
@@ -78,14 +79,14 @@ def test_trigger_is_the_marked_run_of_whole_words_around_the_peak():
 def test_train_local_search_is_checked_before_anything_is_built():
     from emopose.jobs.train_local import TrainLocalJob
 
-    assert TrainLocalJob(search={"act_cost": [-1.0, -0.5], "temperature": [2, 3]}).search
+    assert TrainLocalJob(search={"act_cost": [-1.0, -0.5], "temperature": [2, 3]}, retrain=False).search
     with pytest.raises(ValueError, match="unknown split parameters"):
-        TrainLocalJob(search={"epochs": [3]})
+        TrainLocalJob(search={"epochs": [3]}, retrain=False)
     with pytest.raises(ValueError, match="list of numbers"):
-        TrainLocalJob(search={"act_cost": -1.0})
+        TrainLocalJob(search={"act_cost": -1.0}, retrain=False)
 
 
-@pytest.mark.parametrize("override, message", [  # the training block is validated by pydantic (local_config.py)
+@pytest.mark.parametrize("override, message", [  # validated by pydantic (planners/local/config.py)
     ("planner.training.split_loss_weight=abc", "split_loss_weight\n  Input should be a valid number"),
     ("planner.training.seed=1.5", "seed\n  Input should be a valid integer"),
     ("planner.training.epochs=0", "epochs\n  Input should be greater than or equal to 1"),
@@ -93,12 +94,16 @@ def test_train_local_search_is_checked_before_anything_is_built():
     ("planner.training.trainable_layers=7", "trainable_layers\n  Input should be less than or equal to 6"),
     ("+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
     ("~planner.training.epochs", "epochs\n  Field required"),  # the YAML is the one place of every value
-    ("planner.temperature=0", "temperature must be positive"),
-    ("planner.variant_class_weight=-1", "variant_class_weight must be a finite number >= 0"),
-    ("planner.variant_class_weight_new=.inf", "variant_class_weight_new must be a finite number >= 0"),
-    ("planner.variant_shared_weight=-0.5", "variant_shared_weight must be a finite number >= 0"),
-    ("planner.variant_pretrained_share=1.5", "variant_pretrained_share must be a number from 0 to 1"),
-    ("planner.history_threshold=null", "history_threshold must be a number"),
+    ("~planner.history_threshold", "history_threshold\n  Field required"),
+    ("+planner.temprature=2", "temprature\n  Extra inputs are not permitted"),
+    ("planner.temperature=0", "temperature\n  Input should be greater than 0"),
+    ("planner.variant_class_weight=-1", "variant_class_weight\n  Input should be greater than or equal"),
+    ("planner.variant_class_weight_new=inf", "variant_class_weight_new\n  Input should be a finite number"),
+    ("planner.variant_shared_weight=-0.5", "variant_shared_weight\n  Input should be greater than"),
+    ("planner.variant_pretrained_share=1.5", "variant_pretrained_share\n  Input should be less than"),
+    ("planner.history_threshold=null", "history_threshold\n  Input should be a valid number"),
+    ("planner.history_threshold=nan", "history_threshold\n  Value error, must be a number"),
+    ("~planner.train_if_missing", "missing 1 required keyword-only argument: 'train_if_missing'"),
 ])
 def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path, override, message, compose):
     from emopose.build import ConfigError, make
@@ -107,6 +112,44 @@ def test_a_wrong_planner_override_is_a_config_error_before_any_training(tmp_path
     with pytest.raises(ConfigError, match=re.escape(message)):
         make(cfg.planner, "planner", library=make(cfg.library, "library"))
     assert not list(tmp_path.iterdir())  # nothing trained, nothing cached
+
+
+@pytest.mark.parametrize("train_if_missing", [True, False])
+def test_training_runs_only_as_the_named_first_use_step(tmp_path, compose, monkeypatch, train_if_missing):
+    """No cached artifact: train_if_missing trains before the planner is built (its __init__ only loads);
+    without it, building fails naming the job that trains and the setting."""
+    from emopose.build import ConfigError, make
+    from emopose.planners.local import artifact
+
+    class Trained(Exception):
+        pass
+
+    def train_artifact(paths, cache_dir, config, catalogue):
+        assert cache_dir == str(tmp_path) and "face_wave" in catalogue
+        raise Trained  # a stand-in for minutes of training
+
+    monkeypatch.setattr(artifact, "train_artifact", train_artifact)
+    cfg = compose("planner=local", f"planner.cache_dir={tmp_path}",
+                  f"planner.train_if_missing={train_if_missing}")
+    library = make(cfg.library, "library")
+    if train_if_missing:
+        with pytest.raises(Trained):
+            make(cfg.planner, "planner", library=library)
+    else:
+        with pytest.raises(ConfigError, match=r"no trained local planner at .*python -m emopose "
+                                              r"\+experiment=train_local.*planner\.train_if_missing=true"):
+            make(cfg.planner, "planner", library=library)
+
+
+def test_the_yaml_sets_every_setting_and_trains_on_first_use_by_default(compose):
+    from omegaconf import OmegaConf
+
+    from emopose.planners.local.config import LocalSettings
+
+    planner = OmegaConf.to_container(compose("planner=local").planner, resolve=True)
+    assert planner.pop("_target_") == "emopose.planners.local.planner.LocalPlanner.from_config"
+    assert planner.pop("train_if_missing") is True  # the README's main job trains on a fresh machine
+    assert LocalSettings.model_validate(planner).training.holdout_percent == 10
 
 
 def test_segments_keep_spans_and_boundary_strength():
@@ -125,10 +168,14 @@ def planner(tmp_path_factory):
 
 @pytest.mark.slow
 def test_quality_floor_on_held_out_training_slice(planner):
-    from emopose.jobs.train_local import context_metrics, held_out_metrics, scored_dialogues
-    from emopose.planners.local.data import load_examples
+    from emopose.jobs.train_local import (
+        context_metrics,
+        held_out_examples,
+        held_out_metrics,
+        scored_dialogues,
+    )
 
-    held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
+    held_out = held_out_examples(planner)
     utterances = [e for e in held_out if not e.history]
     metrics = held_out_metrics(planner, utterances, [planner.score(e.text) for e in utterances])
     dialogues = [e for e in held_out if e.history]
@@ -157,6 +204,15 @@ def test_ordered_plan_with_triggers_from_the_reply(planner):
 
 
 @pytest.mark.slow
+def test_the_loaded_planner_keeps_the_planner_contract(planner):
+    from emopose.planners.base import ModalPlanner, Planner
+    from emopose.planners.local.planner import LocalPlanner
+
+    assert isinstance(planner, LocalPlanner) and isinstance(planner, Planner) and not planner.sampled
+    assert not isinstance(planner, ModalPlanner)  # it always narrates: the reply is the utterance
+
+
+@pytest.mark.slow
 def test_blank_utterance_gets_a_plan_without_gestures(planner):
     for text in ("", "   \n", "\u200b"):  # a zero-width space alone has no token either
         assert json.loads(planner.plan(PlanRequest(text)).raw) == {"reply": text, "gestures": []}
@@ -169,7 +225,8 @@ def test_new_variant_is_selectable_without_retraining(planner):
     before = json.loads(planner.plan(PlanRequest(utterance)).raw)["gestures"][0]
     assert before["class"] == "welcoming"
     wave = planner.library.get("face_wave")
-    planner.library.save({"name": "sailor_salute", "class": "welcoming", "keyframes": [list(k) for k in wave.q],
+    planner.library.save({"name": "sailor_salute", "class": "welcoming",
+                          "keyframes": [list(k) for k in wave.q],
                           "description": "A crisp sailor's salute: right hand snaps to the brow, then down."})
     after = json.loads(planner.plan(PlanRequest(utterance)).raw)["gestures"][0]
     assert after["variant"] == "sailor_salute"

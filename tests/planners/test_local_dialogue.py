@@ -31,9 +31,9 @@ def unrelated_histories(planner):
     """Held-out items without history, each with the history of a held-out dialogue (seeded draw)."""
     import random
 
-    from emopose.planners.local.data import load_examples
+    from emopose.jobs.train_local import held_out_examples
 
-    held_out = load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
+    held_out = held_out_examples(planner)
     histories = [e.history for e in held_out if e.history]
     rng = random.Random(0)
     return [(e, rng.choice(histories)) for e in held_out if not e.history], [e for e in held_out if e.history]
@@ -77,7 +77,7 @@ def test_a_history_that_does_not_bear_on_the_utterance_is_dropped(planner):
     assert own_rate >= 0.85 and sum(r >= 0 for r in others) / len(others) <= own_rate - 0.05, own_rate
     assert sum(r >= 0 for *_, r in judged) / len(judged) <= 0.35
     assert model.analyse(["Over there."])[0].relevance_logit is None  # no history, nothing to judge
-    dropped = [(e, history) for e, history, r in judged if r < planner.history_threshold]
+    dropped = [(e, history) for e, history, r in judged if r < planner.settings.history_threshold]
     assert len(dropped) >= 0.4 * len(judged)
     for e, history in dropped:
         assert [(a.cls, a.start, a.end) for a in planner.acts(e.text, history)[1]] == \

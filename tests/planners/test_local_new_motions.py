@@ -55,12 +55,10 @@ def test_each_new_motion_is_picked_for_the_utterances_about_it(planner):
 # variant_class_weight_new; conf/planner/local.yaml has the cost with more motions added).
 @pytest.mark.slow
 def test_new_motions_cost_the_reading_of_other_utterances_little(tmp_path):
-    from emopose.jobs.train_local import held_out_metrics
-    from emopose.planners.local.data import load_examples
+    from emopose.jobs.train_local import held_out_examples, held_out_metrics
 
     planner = configured_local_planner(tmp_path / "g1")
-    examples = [e for e in load_examples(planner.train_files, planner.config.holdout_percent, held_out=True)
-                if not e.history]
+    examples = [e for e in held_out_examples(planner) if not e.history]
     scored = [planner.score(e.text) for e in examples]
     before = held_out_metrics(planner, examples, scored)
     add_new_motions(planner)

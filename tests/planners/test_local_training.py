@@ -109,4 +109,5 @@ def test_linear_schedule_warms_up_then_decays_to_zero():
     rates = [factor(step) for step in range(100)]
     assert rates[0] == pytest.approx(0.2) and rates[4] == pytest.approx(1.0)  # 5 warm-up steps
     assert all(a >= b for a, b in zip(rates[4:], rates[5:])) and rates[-1] == pytest.approx(1 / 95)
-    assert {learning_rate_factor(training_config(lr_schedule="constant"), 100)(step) for step in range(100)} == {1.0}
+    constant = learning_rate_factor(training_config(lr_schedule="constant"), 100)
+    assert {constant(step) for step in range(100)} == {1.0}

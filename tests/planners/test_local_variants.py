@@ -1,4 +1,4 @@
-"""The local planner's variant choice (planners/local_variants.py), on hand-made vectors: no model."""
+"""The local planner's variant choice (planners/local/variants.py), on hand-made vectors: no model."""
 
 from __future__ import annotations
 
@@ -8,15 +8,8 @@ import numpy as np
 import pytest
 
 from emopose import CLASSES
-from emopose.planners.local.variants import (
-    AnnotatedAct,
-    ClassMove,
-    Features,
-    VariantChooser,
-    Weights,
-    fit_variants,
-    new_projections,
-)
+from emopose.planners.local.variant_training import AnnotatedAct, fit_variants
+from emopose.planners.local.variants import ClassMove, Features, VariantChooser, Weights, new_projections
 
 CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who knows"),
              "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}
@@ -51,9 +44,11 @@ def chooser():
 
 def test_the_best_fitting_motion_of_the_class_is_chosen(chooser):
     unsure = proba(doubting=0.6, rejecting=0.4)
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("shrug"), STAY) == ("doubting", "shrug")
+    chosen = chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("shrug"), STAY)
+    assert chosen == ("doubting", "shrug")
     # without the class weight the class is the split model's, even when another class's motion fits
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("finger_wag"), STAY)[0] == "doubting"
+    chosen = chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("finger_wag"), STAY)
+    assert chosen[0] == "doubting"
 
 
 def test_a_clearly_better_motion_may_move_an_unsure_act_but_not_a_sure_one(chooser):
@@ -70,8 +65,8 @@ def test_a_clearly_better_motion_may_move_an_unsure_act_but_not_a_sure_one(choos
 
 def test_a_motion_the_training_data_never_annotated_moves_the_class_further():
     # finger_wag was added by file: the class head never read an act about it
-    chooser = VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0),
-                             frozenset(CATALOGUE) - {"finger_wag"})
+    weights = Weights(word=1.0, shared=1.0, pretrained_share=0.0)
+    chooser = VariantChooser(new_projections(4), describe, weights, frozenset(CATALOGUE) - {"finger_wag"})
     scolding, sure = act_near("finger_wag"), proba(doubting=0.999)
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding, MOVE)[0] == "doubting"
     # the class head was sure without knowing the new motion; its clear fit moves the act all the same
@@ -101,7 +96,8 @@ def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser
     scolding = act_near("finger_wag")
     unsure = proba(doubting=0.6, rejecting=0.4)
     # the split model's class has no motion in the library: it stays, without a motion
-    assert chooser.choose(lambda: CATALOGUE, 1, "neutral", proba(neutral=0.99), scolding, MOVE) == ("neutral", None)
+    chosen = chooser.choose(lambda: CATALOGUE, 1, "neutral", proba(neutral=0.99), scolding, MOVE)
+    assert chosen == ("neutral", None)
     # the act next to it is already rejecting: neighbouring acts keep differing in class
     assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, scolding, MOVE,
                           frozenset({"rejecting"}))[0] == "doubting"
@@ -109,16 +105,19 @@ def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser
 
 def test_a_rare_word_the_description_also_says_decides_between_motions():
     # token ids: 7 "naughty" (rare), 1 "the" (frequent); only finger_wag's description says "naughty"
-    words = {"finger_wag": (np.array([7, 1]), np.array([0.9, 0.01])), "palm_stop": (np.array([1]), np.array([0.01]))}
+    words = {"finger_wag": (np.array([7, 1]), np.array([0.9, 0.01])),
+             "palm_stop": (np.array([1]), np.array([0.01]))}
     chooser = VariantChooser(new_projections(4), lambda texts: describe(texts, words),
                              Weights(word=0.0, shared=1.0, pretrained_share=0.0), frozenset(CATALOGUE))
     # the vectors lean to palm_stop; the shared rare word outweighs them
     naughty = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 7]), np.array([0.01, 0.9])))
-    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, STAY)[1] == "finger_wag"
+    chosen = chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, STAY)
+    assert chosen[1] == "finger_wag"
     # sharing only a frequent word carries no weight against the vectors; a token no description has (an
     # id past every description's) counts against the share
     plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5, 30000]), np.array([0.01, 0.9, 0.9])))
-    assert chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, STAY)[1] == "palm_stop"
+    chosen = chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, STAY)
+    assert chosen[1] == "palm_stop"
 
 
 def test_a_share_of_the_pretrained_similarity_keeps_a_motion_the_projections_lost():
@@ -142,7 +141,8 @@ def test_a_share_of_the_pretrained_similarity_keeps_a_motion_the_projections_los
 
 
 def test_an_empty_library_leaves_the_class_without_a_motion(chooser):
-    assert chooser.choose(lambda: {}, 1, "doubting", proba(doubting=1.0), act_near("shrug"), MOVE) == ("doubting", None)
+    chosen = chooser.choose(lambda: {}, 1, "doubting", proba(doubting=1.0), act_near("shrug"), MOVE)
+    assert chosen == ("doubting", None)
 
 
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
@@ -161,10 +161,11 @@ def test_projections_learn_the_annotated_motion():
     import torch
 
     torch.manual_seed(0)
-    described = {n: (c, torch.eye(4)[AXIS[n]], torch.eye(4)[AXIS[n]]) for n, (c, _) in CATALOGUE.items()}
+    axes = torch.eye(4)
+    described = {n: (c, axes[AXIS[n]], axes[AXIS[n]]) for n, (c, _) in CATALOGUE.items()}
     # acts exactly between two doubting motions, annotated with the second: untrained, the tie goes to the
     # first; trained, the projections tell them apart
-    between = torch.nn.functional.normalize(torch.eye(4)[AXIS["chin_stroke"]] + torch.eye(4)[AXIS["shrug"]], dim=0)
+    between = torch.nn.functional.normalize(axes[AXIS["chin_stroke"]] + axes[AXIS["shrug"]], dim=0)
     vector = between.numpy()
     projections = new_projections(4)
 
@@ -176,6 +177,7 @@ def test_projections_learn_the_annotated_motion():
 
     assert chosen() == "chin_stroke"
     acts = [AnnotatedAct("doubting", "shrug", between.clone(), between.clone()) for _ in range(64)]
-    cfg = SimpleNamespace(seed=0, head_lr=0.05, batch_size=16, logit_scale=20.0, variant_holdout=0.0, variant_epochs=20)
+    cfg = SimpleNamespace(seed=0, head_lr=0.05, batch_size=16, logit_scale=20.0, variant_holdout=0.0,
+                          variant_epochs=20)
     fit_variants(projections, acts, described, cfg, progress=False)
     assert chosen() == "shrug"

@@ -7,8 +7,9 @@ import re
 import pytest
 
 from emopose import CLASSES
-from emopose.build import ConfigError, make
+from emopose.build import ConfigError, make_with
 from emopose.config import PROJECT_ROOT
+from emopose.planners.base import PlannerMode
 from emopose.planners.chat.direct_label import DirectLabelPlanner
 from emopose.planners.chat.guide import library_guide
 from emopose.planners.chat.llm import LLMPlanner
@@ -23,7 +24,8 @@ def _section(path, title: str) -> str:
 def test_both_templates_share_the_class_definitions():
     structured = _section(PROJECT_ROOT / "prompts/structured.md", "Classes")
     assert structured == _section(PROJECT_ROOT / "prompts/direct_label.md", "Classes")
-    assert [line.split(":")[0][2:] for line in structured.splitlines() if line.startswith("- ")] == list(CLASSES)
+    listed = [line.split(":")[0][2:] for line in structured.splitlines() if line.startswith("- ")]
+    assert listed == list(CLASSES)
 
 
 def test_template_header_is_stripped_and_fields_declared():
@@ -46,14 +48,17 @@ def test_guide_lists_classes_in_order_with_defaults(writable_library):
 
 
 def test_planner_configs_compose_and_build(writable_library, demonstrations_file, tmp_path, compose):
-    common = [f"prompt.demonstrations={demonstrations_file}", f"planner.cache_dir={tmp_path}"]
-    llm = make(compose("planner=llm", *common).planner, "planner", library=writable_library)
-    assert isinstance(llm, LLMPlanner) and llm.client.temperature == 0.7 and llm.mode == "narrate"
-    label = make(compose("planner=direct_label", *common).planner, "planner", library=writable_library)
+    common = [f"prompt.demonstrations={demonstrations_file}", f"planner.client.cache_dir={tmp_path}"]
+    resources = {"library": writable_library}
+    llm = make_with(compose("planner=llm", *common).planner, "planner", resources)
+    assert isinstance(llm, LLMPlanner) and llm.client.temperature == 0.7 and llm.mode is PlannerMode.NARRATE
+    assert llm.library is writable_library
+    label = make_with(compose("planner=direct_label", *common).planner, "planner", resources)
     assert isinstance(label, DirectLabelPlanner) and label.template.path.name == "direct_label.md"
+    assert label.client.model == llm.client.model and label.client.max_tokens == llm.client.max_tokens
     wrong = ["planner=llm", f"planner.template={PROJECT_ROOT / 'prompts/direct_label.md'}", *common]
     with pytest.raises((ConfigError, PromptError), match="library_guide"):
-        make(compose(*wrong).planner, "planner", library=writable_library)
+        make_with(compose(*wrong).planner, "planner", resources)
 
 
 def test_demonstration_lines_follow_the_mode(demonstrations_file):
@@ -77,10 +82,11 @@ def test_prompt_text_does_not_leak_suite_items():
             (PROJECT_ROOT / "experiments").glob("bench/*.jsonl")):
         for row in map(json.loads, filter(str.strip, path.read_text(encoding="utf-8").splitlines())):
             suites.append(Text.of(f"{path.stem}:{row['id']}", row["text"]))
-    assert len(suites) >= 480 + 320 + 320, "experiments/ is missing suite files: they ship with the repository"
+    assert len(suites) >= 480 + 320 + 320, "experiments/ is missing suite files: they ship with the repo"
     shown = []
     for name in ("structured.md", "direct_label.md"):
-        for k, quote in enumerate(re.findall(r'"([^"$]{6,})"', (PROJECT_ROOT / "prompts" / name).read_text())):
+        quotes = re.findall(r'"([^"$]{6,})"', (PROJECT_ROOT / "prompts" / name).read_text())
+        for k, quote in enumerate(quotes):
             shown.append(Text.of(f"{name}:{k}", quote))
     demos = (PROJECT_ROOT / "prompts/demonstrations.jsonl").read_text(encoding="utf-8")
     for row in map(json.loads, filter(str.strip, demos.splitlines())):

@@ -10,7 +10,6 @@ import pytest
 from fake_answers import http_error
 from fake_stream import streamed, tokens
 
-from emopose.config import PROJECT_ROOT
 from emopose.execution.sequencer import State
 from emopose.planners.baselines.keyword import KeywordPlanner
 from emopose.planners.chat.annotate import AnnotatePlanner
@@ -25,10 +24,9 @@ FIRST = len(tokens(SENTENCES[0])) + 1  # the next token's leading space shows th
 
 
 @pytest.fixture
-def wired(writable_library, planner_kwargs, tmp_path):
-    planner = AnnotatePlanner(library=writable_library, template=str(PROJECT_ROOT / "prompts/annotate.md"),
-                              annotator=KeywordPlanner(), stream=True,
-                              **{**planner_kwargs, "cache": False, "max_retries": 0})
+def wired(writable_library, make_chat, tmp_path):
+    planner = make_chat(AnnotatePlanner, "prompts/annotate.md", annotator=KeywordPlanner(), stream=True,
+                        cache=False, max_retries=0)
     built = wire(writable_library, tmp_path / "run", planner=planner, mode="timeline")
     with built.session:
         yield built
@@ -53,7 +51,7 @@ def test_sentences_are_performed_in_order_and_each_clip_starts_where_the_last_en
     assert {"pointing", "rejecting"} <= {r.cls for t in reply.turns for r in t.plan.records}
     assert fake_openai.requests[0]["stream"] is True
     assert reply.turns[0].schedule.preroll_s == 0.0  # planner.stream_preroll_s: the first words never wait
-    assert wired.runner.history[-1] == {"role": "assistant", "content": REPLY}
+    assert wired.runner.dialogue.messages[-1] == {"role": "assistant", "content": REPLY}
     assert wired.sequencer.settled() and wired.sequencer.state == State.IDLE  # waited once, at the end
 
 
@@ -62,7 +60,8 @@ def test_each_sentences_gestures_are_released_against_its_own_speech(fake_openai
     turn = wired.runner.run_streamed("Where can I charge my phone?").turns[1]
     (command,) = turn.submitted.commands
     release = turn.schedule.releases[command.record].release_s
-    strokes = [e for e in wired.sequencer.events.since(0) if e.kind == "stroke" and e.command_id == command.id]
+    strokes = [e for e in wired.sequencer.events.since(0)
+               if e.kind == "stroke" and e.command_id == command.id]
     assert turn.dispatched.speech_start > turn.submitted.speech_start  # it waited for the first sentence
     assert strokes and strokes[0].t >= turn.dispatched.speech_start + release
 
@@ -91,7 +90,7 @@ def test_an_interrupt_cancels_the_stream_and_the_server_sees_it_closed(fake_open
 
     reply = wired.runner.run_streamed("Where can I charge my phone?", on_turn=interrupt)
     assert reply.cancelled and [t.plan.reply for t in reply.turns] == SENTENCES[:1]
-    assert wired.runner.history[-1]["content"] == SENTENCES[0]
+    assert wired.runner.dialogue.messages[-1]["content"] == SENTENCES[0]
     for _ in range(500):  # the server finds out at its next write but one (the peer's reset comes between)
         if fake_openai.streams_dropped or fake_openai.answered:
             break

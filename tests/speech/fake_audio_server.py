@@ -35,7 +35,8 @@ class FakeAudioServer:
                 body = self.rfile.read(int(self.headers.get("Content-Length", 0)))
                 server.requests.append((self.path, dict(self.headers), body))
                 if server.status != 200:
-                    self._send(server.status, b'{"error": {"message": "scripted failure"}}', "application/json")
+                    self._send(server.status, b'{"error": {"message": "scripted failure"}}',
+                               "application/json")
                 elif self.path.endswith("/audio/transcriptions"):
                     self._send(200, json.dumps({"text": server.transcript}).encode(), "application/json")
                 elif self.path.endswith("/audio/speech"):

@@ -17,7 +17,8 @@ def audio_file(tmp_path):
 
 def test_audio_file_is_posted_and_transcribed(audio_file):
     with FakeAudioServer(transcript="Where is the robot arm?") as server:
-        asr = LitellmTranscriber(model="openai/whisper-1", api_base=server.url, api_key="sk-test", language="en")
+        asr = LitellmTranscriber(model="openai/whisper-1", api_base=server.url, api_key="sk-test",
+                                 language="en")
         assert asr.utterance(audio=audio_file) == "Where is the robot arm?"
     path, headers, body = server.requests[0]
     assert path == "/v1/audio/transcriptions"

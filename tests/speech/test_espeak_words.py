@@ -26,7 +26,8 @@ REPLIES = [
 
 def _long_reply() -> str:
     rng = random.Random(7)
-    words = ["the", "robot", "arm", "is", "over", "there", "and", "we", "can", "see", "42", "interesting", "things", "in", "this", "lab", "today"]
+    words = ["the", "robot", "arm", "is", "over", "there", "and", "we", "can", "see", "42", "interesting",
+             "things", "in", "this", "lab", "today"]
     return " ".join(rng.choice(words) for _ in range(500)) + " FINALWORD."
 
 

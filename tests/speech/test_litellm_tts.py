@@ -36,7 +36,8 @@ def test_a_keyless_local_server_is_reached_without_a_key(tmp_path, monkeypatch):
 def test_hosted_failure_falls_back_to_espeak_with_a_warning(tmp_path, caplog):
     with FakeAudioServer() as server:
         server.status = 401
-        tts = LitellmSpeech(model="openai/tts-1", api_base=server.url, api_key="sk-test", audio_dir=str(tmp_path))
+        tts = LitellmSpeech(model="openai/tts-1", api_base=server.url, api_key="sk-test",
+                            audio_dir=str(tmp_path))
         with caplog.at_level(logging.WARNING, logger="emopose.speech.litellm_tts"):
             clip = tts.synthesize(REPLY)
     assert not clip.estimated and clip.words and clip.duration_s > 1.0  # the local engine's true timings

@@ -56,7 +56,8 @@ def test_stray_events_on_whitespace_or_backwards_are_dropped():
               WordEvent(16, 4, 1.2), WordEvent(-1, 0, 1.3), WordEvent(99, 1, 1.3)]
     assert clean_events(text, events) == {0: 0.0, 5: 0.3, 12: 1.0, 16: 1.2}
     words = words_from_events(text, events, 1.5)
-    assert [(w.text, w.start_s) for w in words] == [("Look", 0.0), ("there.", 0.3), ("And", 1.0), ("here", 1.2)]
+    assert [(w.text, w.start_s) for w in words] == [("Look", 0.0), ("there.", 0.3), ("And", 1.0),
+                                                    ("here", 1.2)]
 
 
 def test_token_pieces_start_at_the_token_and_onsets_are_clamped():

@@ -18,6 +18,8 @@ class StillClock:
     compares exactly and any wait on the clock shows up in `sleeps`. Wall-clock figures:
     benchmarks/player_start.py."""
 
+    realtime = True
+
     def __init__(self, t: float) -> None:
         self.t, self.sleeps = t, 0
 

@@ -17,6 +17,8 @@ DEVICE = [sys.executable, "-c", "import sys; open(sys.argv[1], 'a').write('playe
 class SteppedClock:
     """A real-time clock to the player (devices are used) that moves only when the test says so."""
 
+    realtime = True
+
     def __init__(self) -> None:
         self.t, self._moved = 0.0, threading.Condition()
 

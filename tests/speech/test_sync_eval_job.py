@@ -9,6 +9,7 @@ import pytest
 from emopose.app import run
 from emopose.build import build_run, make
 from emopose.config import project_path
+from emopose.jobs.sync_eval import SyncEvalJob
 from emopose.sync.recording import read_stroke_sync
 from tests.conftest import synthetic_library
 
@@ -51,11 +52,30 @@ def test_the_timeline_lands_strokes_on_their_words_and_the_recording_measures_it
 
 
 def test_sync_eval_falls_back_to_the_fixture_and_needs_true_word_events(tmp_path, compose):
-    common = [f"job.suite={tmp_path / 'absent.jsonl'}", "job.limit=2", *synthetic_library(tmp_path / "library")]
-    results = run(compose("+experiment=sync_eval", f"tts.audio_dir={tmp_path / 'tts'}", *common), tmp_path / "run")
+    common = [f"job.suite={tmp_path / 'absent.jsonl'}", "job.limit=2",
+              *synthetic_library(tmp_path / "library")]
+    results = run(compose("+experiment=sync_eval", f"tts.audio_dir={tmp_path / 'tts'}", *common),
+                  tmp_path / "run")
     assert results["suite"] == FIXTURE_SUITE and results["items"] == 2
     with pytest.raises(ValueError, match="tts=espeak"):
         run(compose("+experiment=sync_eval", "tts=none", *common), tmp_path / "run2")
+
+
+def test_each_mode_measures_a_reconfigured_copy_of_the_configured_stages(tmp_path, compose):
+    cfg = compose("+experiment=sync_eval", f"tts.audio_dir={tmp_path / 'tts'}",
+                  "pipeline.stages.sequence.interrupt=true", "pipeline.stages.dispatch.until=settle",
+                  *synthetic_library(tmp_path / "library"))
+    with build_run(cfg, tmp_path / "run") as run_:
+        configured = run_.resources.pipeline
+        measured = SyncEvalJob._pipeline(configured, "anchor")
+    assert measured.names == ["resolve", "modulate", "schedule", "sequence", "dispatch"]
+    assert measured.get("resolve") is configured.get("resolve")
+    schedule, sequence, dispatch = (measured.get(n) for n in ("schedule", "sequence", "dispatch"))
+    assert schedule.mode == "anchor" and schedule.timeline == configured.get("schedule").timeline
+    assert not sequence.interrupt and dispatch.until == "rest"
+    # the configured stages are left as they were
+    assert configured.get("schedule").mode == "timeline" and configured.get("sequence").interrupt
+    assert configured.get("dispatch").until == "settle"
 
 
 @pytest.mark.parametrize("group, option", [("asr", "none"), ("asr", "litellm"), ("player", "auto"),

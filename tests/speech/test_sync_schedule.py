@@ -41,7 +41,8 @@ def _turn(reply, triggers):
 def test_missing_triggers_are_flagged_and_logged(espeak, library, mode, caplog):
     reply = "Welcome to the lab. The robot arm is over there."
     with caplog.at_level(logging.WARNING, logger="emopose.stages.schedule"):
-        speech, schedule = ScheduleStage(espeak, library.limits, mode=mode)(_turn(reply, ["Welcome", "under the table", "over there"]))
+        speech, schedule = ScheduleStage(espeak, library.limits, mode=mode)(
+            _turn(reply, ["Welcome", "under the table", "over there"]))
     assert speech.text == reply and speech.words
     assert schedule.missing_triggers == [1]
     assert [r.how for r in schedule.releases][1] == "interpolated"

@@ -24,9 +24,10 @@ class RecordingBackend(DryRunBackend):
         super().__init__()
         self.stream: list[np.ndarray] = []
 
-    def send(self, t, q) -> None:
-        super().send(t, q)
+    def send(self, t, q) -> np.ndarray:
+        q = super().send(t, q)
         self.stream.append(np.array(q))
+        return q
 
 
 class SlowPlanner:
@@ -56,7 +57,8 @@ def events_of(run, kind, name=None):
 
 
 @pytest.mark.parametrize("latency_s", [0.6, 1.3])  # mid-motion; in the blend between two repeats
-def test_plan_interrupts_thinking_and_the_stream_stays_within_the_speed_bound(library, espeak, tmp_path, latency_s):
+def test_plan_interrupts_thinking_and_the_stream_stays_within_the_speed_bound(library, espeak, tmp_path,
+                                                                              latency_s):
     run = make_run(library, espeak, tmp_path, latency_s=latency_s)
     turn = run.runner.run("Hello robot, where is the arm?")
     thinking_started = events_of(run, "started", "doubting_a")

@@ -42,6 +42,7 @@ def test_duration_invariant(library):
     from emopose.stages.resolve import resolve_record
 
     stage = Modulate(library.limits)
-    durations = {stage.modulate(resolve_record(GestureRecord(cls="agreeing", variant="agreeing_a", intensity=i),
-                                               library)).duration for i in range(1, 6)}
+    durations = {stage.modulate(resolve_record(GestureRecord(cls="agreeing", variant="agreeing_a",
+                                                             intensity=i), library)).duration
+                 for i in range(1, 6)}
     assert durations == {library.get("agreeing_a").default_duration}

@@ -11,13 +11,15 @@ from emopose.stages.parse import parse_plan
 def test_bare_and_fenced_json():
     body = {"reply": "Hi!", "gestures": [{"class": "welcoming", "variant": "face_wave", "intensity": 4,
                                           "trigger": "Hi", "confidence": 0.9}]}
-    for raw in (json.dumps(body), f"Sure:\n```json\n{json.dumps(body)}\n```", f"```\n{json.dumps(body)}\n```"):
+    for raw in (json.dumps(body), f"Sure:\n```json\n{json.dumps(body)}\n```",
+                f"```\n{json.dumps(body)}\n```"):
         plan = parse_plan(raw)
         assert plan.source == "model" and plan.reply == "Hi!"
         assert plan.records[0].variant == "face_wave" and plan.records[0].intensity == 4
 
 
-@pytest.mark.parametrize("intensity,expected", [(9, 5), (-3, 1), (2.6, 3), ("4", 4), (1e300, 5), (float("inf"), 5)])
+@pytest.mark.parametrize("intensity,expected",
+                         [(9, 5), (-3, 1), (2.6, 3), ("4", 4), (1e300, 5), (float("inf"), 5)])
 def test_intensity_clamped_to_integers(intensity, expected):
     raw = json.dumps({"gestures": [{"class": "agreeing", "intensity": intensity}]})
     assert parse_plan(raw).records[0].intensity == expected

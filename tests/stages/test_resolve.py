@@ -31,4 +31,5 @@ def test_confidence_gating_off_by_default_and_on_when_set(library):
     assert Resolve(library).resolve(record).entry.name == "rejecting_b"
     gated = Resolve(library, min_confidence=0.5).resolve(record)
     assert gated.rule == "gated" and gated.entry.name == "rejecting_a"
-    assert Resolve(library, min_confidence=0.5, gate_to="neutral").resolve(record).entry.name == "neutral_rest"
+    assert (Resolve(library, min_confidence=0.5, gate_to="neutral").resolve(record).entry.name
+            == "neutral_rest")

@@ -32,8 +32,9 @@ def test_scene_question_attaches_the_head_camera_frame_to_the_vlm_request(tmp_pa
     path = tmp_path / "tour.yaml"
     path.write_text(yaml.safe_dump(scenario))
     with FakeOpenAI() as server:
-        cfg = tour_config(tmp_path, "planner=llm", f"planner.api_base={server.url}", "planner.model=openai/fake-model",
-                          "planner.cache=false", "planner.max_retries=0", f"job.tour_file={path}")
+        cfg = tour_config(tmp_path, "planner=llm", f"planner.client.api_base={server.url}",
+                          "planner.client.model=openai/fake-model", "planner.client.cache=false",
+                          "planner.client.max_retries=0", f"job.tour_file={path}")
         results = run(cfg, tmp_path / "run")
         requests = list(server.requests)
     with_image = [r for r in requests if isinstance(user_content(r), list)]

@@ -53,7 +53,7 @@ def test_a_question_during_narration_clears_answers_and_resumes(tmp_path):
     with tour_runner(tmp_path, raw) as (run, tour):
         spy = InterruptSpy(run.resources.sequencer)
         report = tour.run()
-        history = list(run.runner.history)
+        history = list(run.runner.dialogue.messages)
     cut = next(c for c in spy.calls if c["now"] is not None)
     assert cut["pending"] + cut["active"] >= 1  # gestures were queued or running ...
     assert cut["commands"] == 0 and cut["state_after"] == "blending"  # ... and were cleared with a blend
@@ -68,7 +68,8 @@ def test_a_question_during_narration_clears_answers_and_resumes(tmp_path):
     assert all(s.reached and s.within_tolerance for s in report.stops) and report.ended_at_rest
     roles = [(h["role"], h["content"][:12]) for h in history]
     question_at = roles.index(("user", "Who made tha"))
-    assert roles[question_at - 1][0] == "assistant" and roles[question_at + 1] == ("assistant", "Our students")
+    assert (roles[question_at - 1][0] == "assistant"
+            and roles[question_at + 1] == ("assistant", "Our students"))
     assert roles[-1][0] == "assistant" and len(history) >= 5  # the dialogue spans the whole tour
 
 
@@ -95,7 +96,8 @@ def test_a_question_while_walking_stops_the_base_first_then_the_leg_resumes(tmp_
 
 
 def test_stop_the_tour_aborts_and_leaves_the_robot_at_rest(tmp_path):
-    raw = small(interruptions=[{"at_stop": "first", "after_s": 3.0, "text": "Sorry, please stop the tour now."},
+    raw = small(interruptions=[{"at_stop": "first", "after_s": 3.0,
+                                "text": "Sorry, please stop the tour now."},
                                {"at_stop": "second", "text": "Never asked"}])
     with tour_runner(tmp_path, raw) as (run, tour):
         report = tour.run()

@@ -161,17 +161,3 @@ def test_g1_base_maps_odometry_onto_the_map_and_rate_limits():
     assert base.loco.sent[-1] == (0.0, 0.0, 0.0, 0.0) and base.moving()
     now[0] += 1.0
     assert not base.moving()
-
-
-def test_the_tour_job_says_which_backends_have_a_base():
-    from types import SimpleNamespace
-
-    from emopose.backends.g1.backend import G1Backend
-    from emopose.tour.job import TourJob
-    from emopose.tour.scenario import TourConfigError
-
-    spec = load_tour(LAB_FILE)
-    with pytest.raises(TourConfigError, match="backend=dry_run has none"):
-        TourJob().make_base(SimpleNamespace(name="dry_run"), spec)
-    with pytest.raises(TourConfigError, match="job.g1_odometry"):
-        TourJob().make_base(G1Backend(), spec)

@@ -75,7 +75,8 @@ def test_aim_stage_replaces_only_the_peak_keyframes(library):
         changed = not np.allclose(out.keyframes[k], original[k])
         assert changed == (k in peaks)
         if k in peaks:
-            assert pointing_error(out.keyframes[k], 1, scene.in_torso(scene.get("red_box"))) < math.radians(0.5)
+            assert (pointing_error(out.keyframes[k], 1, scene.in_torso(scene.get("red_box")))
+                    < math.radians(0.5))
     report = scene.aims[0]
     assert (report.target, report.side, report.mirrored, report.applied) == ("red_box", "right", False, True)
     assert out.duration == gesture.duration
@@ -83,7 +84,8 @@ def test_aim_stage_replaces_only_the_peak_keyframes(library):
 
 def test_a_target_on_the_other_side_mirrors_the_gesture(library):
     scene = lab_scene(1)  # the blue ball is to the robot's left
-    out = aim_stage(library, scene)(turn_with([pointing_gesture(library, "the blue ball")], "See the blue ball."))[0]
+    out = aim_stage(library, scene)(turn_with([pointing_gesture(library, "the blue ball")],
+                                              "See the blue ball."))[0]
     report = scene.aims[0]
     assert report.target == "blue_ball" and report.side == "left" and report.mirrored
     assert report.error_deg < 0.5 and active_side(out.keyframes) == 0
@@ -133,9 +135,10 @@ def test_a_colliding_aim_is_retried_with_the_arm_further_out(library):
 def test_pointing_eval_measures_the_simulated_hand_within_five_degrees(tmp_path):
     # The aiming, with the arm law's gravity feed-forward: under the plain G1 law (tau = 0) the hand hangs
     # below its target (up to ~11 degrees on the lab tour), which is the law's error, not the aim's.
-    cfg = compose_config(["+experiment=pointing_eval", "arm_law=robot_gravity", *synthetic_library(tmp_path / "lib"),
-                          "job.gesture=pointing_a", "job.probe_azimuth_deg=[-60,60]",
-                          "job.probe_elevation_deg=[-20,20]", "job.settle_s=0.8"])
+    cfg = compose_config(["+experiment=pointing_eval", "arm_law=robot_gravity",
+                          *synthetic_library(tmp_path / "lib"), "job.gesture=pointing_a",
+                          "job.probe_azimuth_deg=[-60,60]", "job.probe_elevation_deg=[-20,20]",
+                          "job.settle_s=0.8"])
     results = run(cfg, tmp_path)
     assert results["targets"] == 6 + 4 and results["reachable"] == results["targets"]
     assert results["all_within_limit"] and results["max_sim_error_deg"] <= 5.0

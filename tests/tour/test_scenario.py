@@ -65,7 +65,8 @@ def test_unknown_interruption_stop_and_pointing_target(tmp_path):
 
 
 def test_interruption_needs_exactly_one_place(tmp_path):
-    message = refused(tmp_path, small(interruptions=[{"at_stop": "first", "during_leg": "second", "text": "?"}]))
+    message = refused(tmp_path,
+                      small(interruptions=[{"at_stop": "first", "during_leg": "second", "text": "?"}]))
     assert "interruptions[0]" in message and "exactly one of at_stop or during_leg" in message
 
 
@@ -108,5 +109,6 @@ def test_job_without_a_scenario_says_how_to_give_one():
 def test_job_names_the_conf_file_of_the_composed_tour():
     raw = copy.deepcopy(lab_raw())
     raw["stops"][0]["pose"]["yaw_deg"] = "east"
-    with pytest.raises(TourConfigError, match=r"conf/tour/lab.yaml: stops\[0\] 'introduction_board'.pose.yaw_deg"):
+    with pytest.raises(TourConfigError,
+                       match=r"conf/tour/lab.yaml: stops\[0\] 'introduction_board'.pose.yaw_deg"):
         TourJob(tour=raw).load()

@@ -27,7 +27,8 @@ SMALL = {
     "arena": {"x": [-1.0, 3.0], "y": [-2.0, 2.5]},
     "stops": [
         {"name": "first", "pose": {"x": 0.6, "y": 0.0, "yaw_deg": 0.0},
-         "narration": "Hello and welcome to the lab! Look at the red box over there. It is really important to us.",
+         "narration": "Hello and welcome to the lab! Look at the red box over there. "
+                      "It is really important to us.",
          "objects": [{"name": "red_box", "position": [1.8, -0.5, 1.0], "aliases": ["box", "red box"],
                       "color": [0.9, 0.1, 0.1]}]},
         {"name": "second", "pose": {"x": 0.6, "y": 0.8, "yaw_deg": 90.0},

@@ -46,11 +46,13 @@ def served(root: Path, *overrides: str, stop: signal.Signals = signal.SIGINT, re
     port = free_port()
     base = f"http://127.0.0.1:{port}"
     # No provider key: every endpoint a test names is a local stub, which must work keyless.
-    env = {k: v for k, v in os.environ.items() if k != "OPENAI_API_KEY"} | {"MUJOCO_GL": "egl", "EMOPOSE_TOKEN": ""}
+    env = ({k: v for k, v in os.environ.items() if k != "OPENAI_API_KEY"}
+           | {"MUJOCO_GL": "egl", "EMOPOSE_TOKEN": ""})
     with open(root / "server.log", "w") as log:
         process = subprocess.Popen(
             [sys.executable, "-m", "emopose", "+experiment=serve", "planner=keyword", f"serve.port={port}",
-             f"run.record={str(record).lower()}", f"hydra.run.dir={root}/run", *library_overrides(library), *overrides],
+             f"run.record={str(record).lower()}", f"hydra.run.dir={root}/run", *library_overrides(library),
+             *overrides],
             stdout=log, stderr=subprocess.STDOUT, env=env)
         try:
             _wait_until_up(process, base, root)
@@ -97,7 +99,8 @@ def watched_page(browser, base: str, width: int = 1400, height: int = 900):
     context = browser.new_context(viewport={"width": width, "height": height})
     page = context.new_page()
     foreign, errors = [], []
-    page.on("request", lambda r: None if r.url.startswith((base, "data:", "blob:")) else foreign.append(r.url))
+    page.on("request",
+            lambda r: None if r.url.startswith((base, "data:", "blob:")) else foreign.append(r.url))
     page.on("pageerror", lambda e: errors.append(str(e)))
     try:
         yield page

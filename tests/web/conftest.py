@@ -23,7 +23,8 @@ LOCAL = "http://127.0.0.1"
 
 def copy_library(root: Path) -> Path:
     """library/g1 copied to root/library/g1 (without its backups)."""
-    assert (SHIPPED / "neutral_rest.yaml").is_file(), f"{SHIPPED} lacks neutral_rest.yaml: the shipped library broke"
+    assert (SHIPPED / "neutral_rest.yaml").is_file(), (f"{SHIPPED} lacks neutral_rest.yaml: "
+                                                       "the shipped library broke")
     target = root / "library" / "g1"
     shutil.copytree(SHIPPED, target, ignore=shutil.ignore_patterns(".backup"))
     return target
@@ -35,7 +36,8 @@ def library_copy(tmp_path: Path) -> Path:
 
 
 def library_overrides(folder: Path) -> list[str]:
-    return [f"library.paths=[{folder}]", f"library.write_dir={folder}", f"library.limits={folder}/limits.yaml"]
+    return [f"library.paths=[{folder}]", f"library.write_dir={folder}",
+            f"library.limits={folder}/limits.yaml"]
 
 
 @functools.lru_cache(maxsize=8)

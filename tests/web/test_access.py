@@ -33,8 +33,8 @@ def test_the_cli_refuses_to_start_on_0000_without_a_token(library_copy, tmp_path
 
     done = subprocess.run([sys.executable, "-m", "emopose", "+experiment=serve", "serve.host=0.0.0.0",
                            f"hydra.run.dir={tmp_path}/run", *library_overrides(library_copy)],
-                          capture_output=True, text=True, timeout=120, check=False, env={**__import__("os").environ,
-                                                                            "EMOPOSE_TOKEN": ""})
+                          capture_output=True, text=True, timeout=120, check=False,
+                          env={**__import__("os").environ, "EMOPOSE_TOKEN": ""})
     assert done.returncode == 2 and "serve.token" in done.stderr
     assert "validation error" not in done.stderr and "pydantic" not in done.stderr  # a sentence, not a dump
     assert "serve.host=0.0.0.0 is reachable from the network" in done.stderr.splitlines()[-1]
@@ -45,7 +45,8 @@ def test_token_is_checked_on_http_and_websocket(serve_app):
     with TestClient(app, base_url="http://robot.lan:8765") as client:
         assert client.get("/api/info").status_code == 401
         assert client.get("/").status_code == 401
-        assert client.get("/api/info", headers={"Authorization": "Bearer wrong-token-0123456789"}).status_code == 401
+        assert client.get("/api/info",
+                          headers={"Authorization": "Bearer wrong-token-0123456789"}).status_code == 401
         assert client.get("/api/info", headers={"Authorization": f"Bearer {TOKEN}"}).status_code == 200
         with pytest.raises(WebSocketDisconnect) as refused, client.websocket_connect("ws://robot.lan:8765/ws"):
             pass
@@ -59,7 +60,8 @@ def test_token_is_checked_on_http_and_websocket(serve_app):
 
 def test_local_bind_refuses_foreign_hosts_and_cross_origin(client):
     assert client.get("/api/info", headers={"Host": "evil.example"}).status_code == 421  # DNS rebinding
-    assert client.post("/api/interrupt", json={}, headers={"Origin": "http://evil.example"}).status_code == 403
+    assert client.post("/api/interrupt", json={},
+                       headers={"Origin": "http://evil.example"}).status_code == 403
     with pytest.raises(WebSocketDisconnect), client.websocket_connect(WS, headers={"Origin": "http://evil.example"}):
         pass
     with client.websocket_connect(WS, headers={"Origin": "http://127.0.0.1"}) as ws:
@@ -73,7 +75,8 @@ def test_foreign_and_opaque_origins_are_refused_on_every_route(client, origin):
     headers = {"Origin": origin}
     refused = client.post("/api/interrupt", json={}, headers=headers)
     assert refused.status_code == 403 and "cross-origin" in refused.json()["error"]
-    assert client.post("/api/gesture", json={"name": "palm_stop", "intensity": 5}, headers=headers).status_code == 403
+    assert client.post("/api/gesture", json={"name": "palm_stop", "intensity": 5},
+                       headers=headers).status_code == 403
     assert client.get("/api/turns", headers=headers).status_code == 403
     with pytest.raises(WebSocketDisconnect) as closed, client.websocket_connect(WS, headers=headers):
         pass

@@ -163,8 +163,8 @@ def test_path_traversal_and_bad_names_are_refused(client, library_copy, name):
 
 
 def test_traversal_in_urls(client):
-    for url in ["/api/library/..%2F..%2Fetc%2Fpasswd", "/api/library/../../etc/passwd", "/api/library/Face_Wave",
-                "/static/../conftest.py", "/static/..%2F..%2Fsettings.py"]:
+    for url in ["/api/library/..%2F..%2Fetc%2Fpasswd", "/api/library/../../etc/passwd",
+                "/api/library/Face_Wave", "/static/../conftest.py", "/static/..%2F..%2Fsettings.py"]:
         response = client.get(url)
         assert response.status_code in (404, 422), url
 

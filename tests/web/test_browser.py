@@ -22,7 +22,8 @@ expect = playwright_api.expect
 def egl_works() -> bool:
     probe = "import mujoco; mujoco.Renderer(mujoco.MjModel.from_xml_string('<mujoco/>'), 8, 8)"
     env = {**os.environ, "MUJOCO_GL": "egl"}
-    return subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, timeout=120, check=False).returncode == 0
+    return subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, timeout=120,
+                          check=False).returncode == 0
 
 
 def backends() -> list:
@@ -51,7 +52,8 @@ def test_chat_reply_cues_and_a_moving_simulation_view(page, server):
     expect(page.locator("#badges")).to_contain_text(server["backend"])
     expect(page.locator("#badges")).to_contain_text("keyword")
     if server["backend"] == "mujoco":
-        page.wait_for_function("Number(document.querySelector('#sim').dataset.frames || 0) >= 3", timeout=30_000)
+        page.wait_for_function("Number(document.querySelector('#sim').dataset.frames || 0) >= 3",
+                               timeout=30_000)
     page.fill("#say-text", "Welcome to the lab! The robot arm is over there, it is really important.")
     page.click("#send")
     bubble = page.locator(".bubble.robot").last
@@ -92,7 +94,8 @@ def test_studio_variant_is_saved_and_the_next_message_resolves_to_it(page, serve
     page.goto(server["base"] + "/studio")
     expect(page.locator("#verdict")).to_have_text("ready to save", timeout=15_000)
     rendering = get_json(server["base"] + "/api/info")["render"]
-    expect(page.locator("#preview-caption")).to_contain_text("MuJoCo" if rendering else "stick", timeout=60_000)
+    expect(page.locator("#preview-caption")).to_contain_text("MuJoCo" if rendering else "stick",
+                                                             timeout=60_000)
     page.fill("#name", name)
     page.select_option("#class", "welcoming")
     page.fill("#description", "a wide raised wave made in the browser test")
@@ -106,7 +109,8 @@ def test_studio_variant_is_saved_and_the_next_message_resolves_to_it(page, serve
     assert (server["library"] / f"{name}.yaml").is_file()
     page.click("#perform")  # the draft on screen, which is now also the saved motion
     expect(page.locator("#perform-result")).to_contain_text("performing the draft on screen", timeout=10_000)
-    expect(page.locator("#name-hint")).to_contain_text("replace the existing motion")  # saving again needs the box
+    # saving again needs the box
+    expect(page.locator("#name-hint")).to_contain_text("replace the existing motion")
     expect(page.locator("#save")).to_be_disabled()
     page.check("#overwrite")
     expect(page.locator("#save")).to_be_enabled()

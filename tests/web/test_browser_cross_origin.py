@@ -24,8 +24,10 @@ PROBE = """
 const report = (r) => parent === window ? (window.__probe = r) : parent.postMessage(r, "*");
 const seen = {origin: self.origin, opened: false, messages: [], close: null};
 const ws = new WebSocket("ws://127.0.0.1:%(port)d/ws");
-ws.onopen = () => { seen.opened = true; ws.send(JSON.stringify({type: "gesture", name: "palm_stop", intensity: 5})); };
-ws.onmessage = (e) => { seen.messages.push(typeof e.data === "string" ? JSON.parse(e.data).type : "binary"); };
+ws.onopen = () => { seen.opened = true; \
+ws.send(JSON.stringify({type: "gesture", name: "palm_stop", intensity: 5})); };
+ws.onmessage = (e) => { \
+seen.messages.push(typeof e.data === "string" ? JSON.parse(e.data).type : "binary"); };
 ws.onclose = (e) => { seen.close = e.code; report(seen); };
 setTimeout(() => report(seen), 4000);
 """
@@ -61,14 +63,17 @@ def test_a_sandboxed_cross_origin_frame_cannot_use_the_robot_socket(browser, tmp
         try:
             page = context.new_page()
             page.goto(f"{origin}/attack.html")
-            page.wait_for_function("window.__framed !== undefined && window.__probe !== undefined", timeout=15_000)
+            page.wait_for_function("window.__framed !== undefined && window.__probe !== undefined",
+                                   timeout=15_000)
             framed, top = page.evaluate("window.__framed"), page.evaluate("window.__probe")
             own = context.new_page()
             own.goto(server["base"] + "/")
-            own.wait_for_function("document.querySelector('#connection').textContent === 'live'", timeout=15_000)
+            own.wait_for_function("document.querySelector('#connection').textContent === 'live'",
+                                  timeout=15_000)
         finally:
             context.close()
         assert framed["origin"] == "null"  # the sandboxed frame really has the opaque origin
         for seen in (framed, top):
-            assert not seen["opened"] and seen["messages"] == [], seen  # refused at the handshake: nothing read
+            # refused at the handshake: nothing read
+            assert not seen["opened"] and seen["messages"] == [], seen
         assert get_json(server["base"] + "/api/turns")["log"] == []  # and nothing performed

@@ -31,7 +31,8 @@ def server(tmp_path_factory):
 
 
 def inside(box: dict, width: int, height: int) -> bool:
-    return box["x"] >= 0 and box["y"] >= 0 and box["x"] + box["width"] <= width and box["y"] + box["height"] <= height
+    return (box["x"] >= 0 and box["y"] >= 0 and box["x"] + box["width"] <= width
+            and box["y"] + box["height"] <= height)
 
 
 def overlap(a: dict, b: dict) -> bool:
@@ -54,14 +55,16 @@ def test_the_live_view_stays_on_screen_and_uncovered(browser, server, size):
         assert inside(view.bounding_box(), width, height), (size, view.bounding_box())
         assert no_sideways_scroll(page, width)
         if camera:
-            page.wait_for_function("Number(document.querySelector('#camera').dataset.frames || 0) >= 1", timeout=30_000)
+            page.wait_for_function("Number(document.querySelector('#camera').dataset.frames || 0) >= 1",
+                                   timeout=30_000)
             assert not overlap(page.locator("#camera-card").bounding_box(), view.bounding_box())
         SHOTS.mkdir(exist_ok=True)
         page.screenshot(path=str(SHOTS / f"chat_{size}.png"))
         page.goto(server["base"] + "/studio")
         expect(page.locator("#verdict")).to_have_text("ready to save", timeout=15_000)
         assert no_sideways_scroll(page, width)
-        assert page.locator("#preview-stick").bounding_box()["x"] + page.locator("#preview-stick").bounding_box()["width"] <= width
+        assert (page.locator("#preview-stick").bounding_box()["x"]
+                + page.locator("#preview-stick").bounding_box()["width"] <= width)
         page.screenshot(path=str(SHOTS / f"studio_{size}.png"), full_page=True)
 
 
@@ -87,4 +90,5 @@ def test_a_rejected_gesture_is_shown_rejected_and_named_gestures_are_silent(brow
         SHOTS.mkdir(exist_ok=True)
         page.screenshot(path=str(SHOTS / "chat_rejected_cue.png"))
         page.reload()  # a page opened later sees the outcome in the history
-        expect(page.locator(".bubble.robot").last.locator(".outcome")).to_contain_text("rejected:", timeout=10_000)
+        expect(page.locator(".bubble.robot").last.locator(".outcome")).to_contain_text("rejected:",
+                                                                                       timeout=10_000)

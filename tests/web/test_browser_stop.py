@@ -34,7 +34,8 @@ def test_sigterm_while_serving_closes_the_recording_and_writes_results(tmp_path)
         assert wait_for(lambda: get_json(server["base"] + "/api/status")["state"] != "idle", timeout_s=10)
     assert server["process"].returncode == 0, (tmp_path / "server.log").read_text()[-3000:]
     with open(server["run"] / "session.mcap", "rb") as f:
-        topics = [channel.topic for _, channel, _ in make_reader(f).iter_messages()]  # every message, to the end
+        # every message, to the end
+        topics = [channel.topic for _, channel, _ in make_reader(f).iter_messages()]
     assert "/joints/command" in topics and len(topics) > 10
     results = json.loads((server["run"] / "results.json").read_text())
     assert results["turns"] == 1 and results["loop"]["ticks"] > 0

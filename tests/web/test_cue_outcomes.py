@@ -19,21 +19,25 @@ REACH_IN = [*REST[:7], -0.5, 0.0, *REST[9:]]  # clean at intensities 1-3, into t
 
 def turn_json(events: list[dict]) -> dict:
     """Three records: 0 ran, 1 was handed to the sequencer (command 8), 2 was dropped by the timeline."""
-    record = {"class": "welcoming", "variant": "face_wave", "intensity": 3, "confidence": 1.0, "trigger": "hi"}
+    record = {"class": "welcoming", "variant": "face_wave", "intensity": 3, "confidence": 1.0,
+              "trigger": "hi"}
     resolved = {"resolved": "face_wave", "resolved_class": "welcoming", "rule": "exact"}
     release = {"release_s": 0.0, "how": "anchor", "dropped": None}
     return {"plan": {"reply": "hi there", "records": [record] * 3}, "resolved": [resolved] * 3,
-            "schedule": {"releases": [release, release, {**release, "dropped": "no room before the next stroke"}]},
+            "schedule": {"releases": [release, release,
+                                      {**release, "dropped": "no room before the next stroke"}]},
             "submitted": {"commands": [{"id": 8, "record": 1}, {"id": 7, "record": 0}]},  # in release order
             "dispatched": {"events": events}}
 
 
 def test_rejected_and_dropped_gestures_are_marked_on_their_cues_with_the_reason():
     events = [{"t": 0.0, "kind": "started", "name": "face_wave", "command_id": 7, "detail": ""},
-              {"t": 0.1, "kind": "rejected", "name": "face_wave", "command_id": 8, "detail": "left hand vs torso"}]
+              {"t": 0.1, "kind": "rejected", "name": "face_wave", "command_id": 8,
+               "detail": "left hand vs torso"}]
     ran, rejected, dropped = cue_rows(turn_json(events))
     assert ran["outcome"] is None and ran["command_id"] == 7
-    assert rejected["outcome"] == {"kind": "rejected", "reason": "left hand vs torso"} and rejected["command_id"] == 8
+    assert (rejected["outcome"] == {"kind": "rejected", "reason": "left hand vs torso"}
+            and rejected["command_id"] == 8)
     assert dropped["outcome"] == {"kind": "dropped", "reason": "no room before the next stroke"}
     assert dropped["command_id"] is None
     events[1] = {**events[1], "kind": "dropped", "detail": "late"}  # any refusal kind, by its event
@@ -46,7 +50,8 @@ def test_a_gesture_rejected_after_its_turn_was_published_is_shown_rejected(serve
     # its pre-roll, before publishing, and the outcome is then on the cue from the start).
     app, session = serve_app("pipeline.stages.schedule.mode=anchor")
     with TestClient(app, base_url=LOCAL) as client:
-        turn = client.post("/api/gesture", json={"name": "reach_in", "intensity": 5}).json()  # published at hand-off
+        # published at hand-off
+        turn = client.post("/api/gesture", json={"name": "reach_in", "intensity": 5}).json()
 
         def logged_outcome():
             log = client.get("/api/turns").json()["log"]
@@ -55,14 +60,16 @@ def test_a_gesture_rejected_after_its_turn_was_published_is_shown_rejected(serve
         assert wait_for(lambda: logged_outcome() is not None)
         assert logged_outcome()["kind"] == "rejected" and "vs torso" in logged_outcome()["reason"]
         announced = [m for m in client.get("/api/turns").json()["log"] if m["type"] == "cue_outcome"]
-        assert [(m["turn_id"], m["k"], m["outcome"]["kind"]) for m in announced] == [(turn["turn_id"], 0, "rejected")]
+        assert ([(m["turn_id"], m["k"], m["outcome"]["kind"]) for m in announced]
+                == [(turn["turn_id"], 0, "rejected")])
         kinds = [e.kind for e in session.res.sequencer.events if e.name == "reach_in"]
         assert "rejected" in kinds and "started" not in kinds
 
 
 def test_a_named_gesture_is_silent_and_a_narrated_turn_says_so(client):
     gesture = client.post("/api/gesture", json={"name": "face_wave"}).json()
-    assert gesture["reply"] == "" and gesture["speech"]["duration_s"] == 0.0  # the motion's name is not spoken
+    # the motion's name is not spoken
+    assert gesture["reply"] == "" and gesture["speech"]["duration_s"] == 0.0
     spoken = client.post("/api/gesture", json={"name": "face_wave", "text": "Hello there!"}).json()
     assert spoken["reply"] == "Hello there!"
     said = client.post("/api/say", json={"text": "Welcome to the lab."}).json()

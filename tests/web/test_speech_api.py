@@ -25,7 +25,8 @@ def transcriber():
 
 @pytest.fixture
 def listening(serve_app, transcriber, monkeypatch):
-    """A client of the server composed with asr=litellm pointed at the stub (keyless, like a local whisper)."""
+    """A client of the server composed with asr=litellm pointed at the stub (keyless, like a local
+    whisper)."""
     monkeypatch.delenv("OPENAI_API_KEY", raising=False)
     app, _ = serve_app("asr=litellm", f"asr.api_base={transcriber.url}")
     with TestClient(app, base_url=LOCAL) as client:

@@ -10,6 +10,7 @@ import time
 import pytest
 
 from emopose.config import PROJECT_ROOT
+from emopose.llm.client import LLMClient
 from emopose.planners.baselines.keyword import KeywordPlanner
 from emopose.planners.chat.annotate import AnnotatePlanner
 
@@ -34,7 +35,8 @@ def live(serve_app, server, tmp_path):
     runner.planner = AnnotatePlanner(
         library=session.res.library, template=str(PROJECT_ROOT / "prompts/annotate.md"),
         demonstrations=str(PROJECT_ROOT / "prompts/demonstrations.jsonl"), annotator=KeywordPlanner(),
-        stream=True, model="openai/fake-model", api_base=server.url, cache=False, max_retries=0, timeout_s=10)
+        stream=True, client=LLMClient(model="openai/fake-model", api_base=server.url, cache=False,
+                                      max_retries=0, timeout_s=10))
     return session
 
 
@@ -51,7 +53,7 @@ def test_each_sentence_is_published_as_its_turn_and_speech_is_chained(live, serv
     assert last["turn_id"] == turns[-1]["turn_id"]
     starts = [t["speech_start"] for t in turns]
     assert starts == sorted(starts) and len(set(starts)) == 3
-    assert live.run.runner.history[-1]["content"] == REPLY
+    assert live.run.runner.dialogue.messages[-1]["content"] == REPLY
 
 
 def test_an_interrupt_cancels_the_streaming_reply(live, server):
@@ -67,7 +69,8 @@ def test_an_interrupt_cancels_the_streaming_reply(live, server):
     interrupted = live.interrupt()
     hold.set()
     worker.join(30)
-    assert [t["reply"] for t in _turns(live)] == ["Welcome to the lab!"] and interrupted["type"] == "interrupted"
+    assert ([t["reply"] for t in _turns(live)] == ["Welcome to the lab!"]
+            and interrupted["type"] == "interrupted")
     assert said["type"] == "reply_stopped" and said["cancelled"] and said["sentences"] == 1
     assert live.res.sequencer.pending == []
     for _ in range(500):

@@ -48,16 +48,19 @@ def test_studio_shows_checks_and_saves_the_stroke(client, library_copy):
 
 def test_studio_preview_without_mujoco_falls_back_to_the_stick_figure(client):
     rest = client.get("/api/library").json()["neutral_pose"]
-    preview = client.post("/api/studio/preview", json={"keyframes": [rest] * 3, "camera": "head", "frames": 5}).json()
+    preview = client.post("/api/studio/preview",
+                          json={"keyframes": [rest] * 3, "camera": "head", "frames": 5}).json()
     assert preview["frames"] == [] and preview["fallback"] == "stick" and len(preview["times"]) == 5
-    assert client.post("/api/studio/preview", json={"keyframes": [rest] * 3, "camera": "../x"}).status_code == 422
+    assert client.post("/api/studio/preview",
+                       json={"keyframes": [rest] * 3, "camera": "../x"}).status_code == 422
 
 
 def test_studio_refuses_a_colliding_or_out_of_limit_motion(client, library_copy):
     rest = client.get("/api/library").json()["neutral_pose"]
     inward = list(rest)
     inward[7], inward[8] = -0.5, 0.9  # right upper arm swung into the torso
-    body = {"name": "hug_torso", "class": "comforting", "description": "collides", "keyframes": [rest, inward, rest]}
+    body = {"name": "hug_torso", "class": "comforting", "description": "collides",
+            "keyframes": [rest, inward, rest]}
     report = client.post("/api/studio/check", json={"keyframes": body["keyframes"]}).json()
     assert not report["can_save"] and "self-collision" in report["problems"][0]
     refused = client.post("/api/library", json=body)
@@ -94,7 +97,8 @@ def test_a_saved_variant_resolves_and_runs_on_the_next_request(client):
     from emopose.planners.chat.guide import library_guide
 
     version = client.get("/api/library").json()["version"]
-    assert client.post("/api/resolve", json={"class": "welcoming", "variant": "wave_test_variant"}).json()["rule"] \
+    assert client.post("/api/resolve",
+                       json={"class": "welcoming", "variant": "wave_test_variant"}).json()["rule"] \
         == "class_default"
     assert client.post("/api/library", json=motion_body(client, "wave_test_variant")).status_code == 201
     resolved = client.post("/api/resolve", json={"class": "welcoming", "variant": "wave_test_variant"}).json()
@@ -104,7 +108,8 @@ def test_a_saved_variant_resolves_and_runs_on_the_next_request(client):
     assert "wave_test_variant" in library_guide(res.library)  # the planners' guide, regenerated
     turn = client.post("/api/gesture", json={"name": "wave_test_variant"}).json()
     assert turn["cues"][0]["resolved"] == "wave_test_variant" and turn["cues"][0]["rule"] == "exact"
-    assert wait_for(lambda: any(e.kind == "started" and e.name == "wave_test_variant" for e in res.sequencer.events))
+    assert wait_for(lambda: any(e.kind == "started" and e.name == "wave_test_variant"
+                                for e in res.sequencer.events))
 
 
 def test_studio_refuses_a_motion_that_collides_only_at_high_intensity(client, library_copy):
@@ -117,7 +122,8 @@ def test_studio_refuses_a_motion_that_collides_only_at_high_intensity(client, li
     assert [c["ok"] for c in report["levels"]] == [True, True, True, False, False]
     assert not report["can_save"] and any("intensity 5" in p for p in report["problems"])
     refused = client.post("/api/library", json={"name": "reach_in", "class": "comforting",
-                                                "description": "collides when strong", "keyframes": keyframes})
+                                                "description": "collides when strong",
+                                                "keyframes": keyframes})
     assert refused.status_code == 422 and "self-collision at intensity 4" in refused.json()["error"]
     assert not (library_copy / "reach_in.yaml").exists()
 
@@ -126,7 +132,8 @@ def test_an_out_of_limits_motion_names_the_offending_joint_its_value_and_its_lim
     rest = client.get("/api/library").json()["neutral_pose"]
     beyond = list(rest)
     beyond[10] = 3.0  # right elbow, past its limit (not the first joint of the list)
-    body = {"name": "elbow_over", "class": "comforting", "description": "too far", "keyframes": [rest, beyond, rest]}
+    body = {"name": "elbow_over", "class": "comforting", "description": "too far",
+            "keyframes": [rest, beyond, rest]}
     error = client.post("/api/library", json=body).json()["error"]
     assert error.count("motion 'elbow_over'") == 1, error  # the prefix is said once
     assert "right_elbow_joint = 3.000 rad in keyframe 1 (allowed" in error and "left_shoulder" not in error
@@ -137,12 +144,14 @@ def test_perform_runs_the_edited_draft_not_the_saved_motion(client):
     saved = client.get("/api/library/face_wave").json()
     draft = [list(k) for k in saved["keyframes"]]
     draft[1][13] += 0.2  # an edit that is not saved
-    turn = client.post("/api/studio/perform", json={"keyframes": draft, "class": "welcoming", "intensity": 2}).json()
+    turn = client.post("/api/studio/perform",
+                       json={"keyframes": draft, "class": "welcoming", "intensity": 2}).json()
     cue = turn["cues"][0]
     assert turn["kind"] == "draft" and cue["resolved"] == "studio_draft" and cue["intensity"] == 2
     assert turn["reply"] == ""  # a draft is performed silently
     res = client.app.state.session.res
-    assert wait_for(lambda: any(e.kind == "started" and e.name == "studio_draft" for e in res.sequencer.events))
+    assert wait_for(lambda: any(e.kind == "started" and e.name == "studio_draft"
+                                for e in res.sequencer.events))
     assert client.get("/api/library").json()["version"] == 1  # the library is untouched
 
 

@@ -40,7 +40,8 @@ class ArmCommandBuilder:
             motors["q"][_WAIST] = waist_q
             motors["kp"][_WAIST] = waist_kp
             motors["kd"][_WAIST] = waist_kd
-        self._q, self._dq, self._tau = motors["q"], motors["dq"], motors["tau"]  # views: writes land in the message
+        # Views: writes land in the message.
+        self._q, self._dq, self._tau = motors["q"], motors["dq"], motors["tau"]
 
     def build(self, q: np.ndarray, weight: float, dq: np.ndarray | None = None,
               tau: np.ndarray | None = None) -> tuple[bytes, int]:

@@ -95,7 +95,8 @@ class G1Backend(Backend):
         self._supervisor.start()
         return hold.copy()
 
-    def send(self, t: float, q: np.ndarray) -> None:
+    def send(self, t: float, q: np.ndarray) -> np.ndarray:
+        """Publish q clamped to the joint limits; returns the clamped targets."""
         q = np.asarray(q, dtype=float)
         if q.shape != (NUM_JOINTS,) or not np.all(np.isfinite(q)):
             raise ValueError(
@@ -108,10 +109,16 @@ class G1Backend(Backend):
                 clamped, 1.0, "stream", t=t, clamped=bool(np.any(clamped != q))
             )
             self._last_send = self._clock.now()
+        return clamped
 
     def measured(self) -> np.ndarray | None:
         link = self._link
         return None if link is None else link.monitor.arm_q()
+
+    @property
+    def is_connected(self) -> bool:
+        """Under SDK weight and taking commands (holding or streaming); False after a fault."""
+        return self._life.state in ACTIVE
 
     def close(self) -> None:
         with self._close_lock:

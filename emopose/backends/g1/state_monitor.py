@@ -17,6 +17,7 @@ import emopose.backends.g1.wire as wire
 from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession
 from emopose.backends.g1.hg_types import LowState_
+from emopose.execution.worker import Worker
 from emopose.robot.g1_spec import ARM_MOTORS, WAIST_MOTORS
 
 log = logging.getLogger(__name__)
@@ -30,22 +31,19 @@ class LowStateMonitor:
         self._now = now
         self._lock = threading.Lock()
         self._first = threading.Event()
-        self._stop = threading.Event()
         self._arm_q: np.ndarray | None = None
         self._waist_q: np.ndarray | None = None
         self._stamp = -np.inf
         self.valid = 0
         self.bad_crc = 0
         self.undecodable = 0
-        self._thread = threading.Thread(target=self._run, name="g1-lowstate", daemon=True)
+        self._worker = Worker("g1-lowstate", self._run, join_timeout_s=1.0)
 
     def start(self) -> None:
-        self._thread.start()
+        self._worker.start()
 
     def stop(self) -> None:
-        self._stop.set()
-        if self._thread.is_alive() and threading.current_thread() is not self._thread:
-            self._thread.join(timeout=1.0)
+        self._worker.stop()
 
     def wait_first(self, timeout_s: float) -> bool:
         return self._first.wait(timeout_s)
@@ -63,12 +61,12 @@ class LowStateMonitor:
         with self._lock:
             return self._now() - self._stamp
 
-    def _run(self) -> None:
-        while not self._stop.is_set():
+    def _run(self, stop: threading.Event) -> None:
+        while not stop.is_set():
             try:
                 samples = self._reader.take(timeout_s=0.05)
             except Exception:  # the participant was deleted under us during close()
-                if not self._stop.is_set():
+                if not stop.is_set():
                     log.exception("reading %s failed", TOPIC_LOWSTATE)
                 return
             # Newest first: one valid state per wake-up is all the backend needs.

@@ -17,6 +17,7 @@ from typing import Protocol
 
 from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.lifecycle import ACTIVE, ArmState
+from emopose.execution.worker import Worker
 from emopose.robot.g1_spec import CONTROL_DT
 
 log = logging.getLogger(__name__)
@@ -66,20 +67,18 @@ class Supervisor:
         self._loss_s, self._deadman_s = lowstate_loss_s, deadman_s
         # Check at least 4x per deadman period so a stall is seen within ~1.25x the limit.
         self._period = min(0.005, deadman_s / 4, lowstate_loss_s / 4)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._run, name="g1-supervisor", daemon=True)
+        self._worker = Worker("g1-supervisor", self._run, join_timeout_s=10.0)
 
     def start(self) -> None:
-        self._thread.start()
+        self._worker.start()
 
     def stop(self) -> None:
-        self._stop.set()
-        if self._thread.is_alive() and threading.current_thread() is not self._thread:
-            self._thread.join(timeout=10.0)
+        """Also called from the supervisor's own thread (a fault tears the backend down)."""
+        self._worker.stop()
 
-    def _run(self) -> None:
+    def _run(self, stop: threading.Event) -> None:
         next_hold = self._now() + CONTROL_DT
-        while not self._stop.wait(self._period):
+        while not stop.wait(self._period):
             vitals = self._target.vitals()
             if vitals.state not in ACTIVE:
                 return  # closing or already released: nothing left to watch

@@ -19,7 +19,7 @@ class ChancePlanner:
     name = "chance"
     sampled = False  # seeded: one pass is reproducible; pass passes=5 to see its spread
 
-    def __init__(self, seed: int = 0, library: object | None = None) -> None:
+    def __init__(self, seed: int = 0) -> None:
         self.seed = seed
         self.rng = np.random.default_rng(seed)
 

@@ -29,7 +29,7 @@ class JaccardPlanner:
     name = "jaccard"
     sampled = False
 
-    def __init__(self, descriptions: str, drop_stop_words: bool = True, library: object | None = None) -> None:
+    def __init__(self, descriptions: str, drop_stop_words: bool = True) -> None:
         self.drop_stop_words = drop_stop_words
         texts = load_class_descriptions(descriptions)
         self.class_tokens = [set(tokenize(texts[c], drop_stop_words)) for c in CLASSES]

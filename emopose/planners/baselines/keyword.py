@@ -60,8 +60,9 @@ class KeywordPlanner:
     """planner=keyword: fixed keyword rules; the reply is the input text (narration mode)."""
 
     name = "keyword"
+    sampled = False
 
-    def __init__(self, max_records: int = 4, library: object | None = None) -> None:
+    def __init__(self, max_records: int = 4) -> None:
         self.max_records = max_records
 
     def plan(self, request: PlanRequest) -> PlannerOutput:

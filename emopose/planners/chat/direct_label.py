@@ -12,10 +12,9 @@ from __future__ import annotations
 
 import json
 import re
-from typing import Any
 
 from emopose import CLASSES
-from emopose.library import MotionLibrary
+from emopose.llm.client import LLMClient
 from emopose.planners.base import PlanRequest
 from emopose.planners.chat.planner import ChatPlanner
 from emopose.planners.chat.prompting import label_demonstrations
@@ -32,8 +31,9 @@ def label_from_answer(text: str) -> str | None:
 class DirectLabelPlanner(ChatPlanner):
     name = "direct_label"
 
-    def __init__(self, library: MotionLibrary, template: str, demonstrations: str, **kwargs: Any) -> None:
-        super().__init__(library, template, demonstrations, **kwargs)
+    def __init__(self, client: LLMClient, template: str, demonstrations: str,
+                 max_demonstrations: int | None = None) -> None:
+        super().__init__(client, template, demonstrations, max_demonstrations)
         self.template.require("labels", hint="planner=direct_label goes with prompt=direct_label.")
         # The prompt does not depend on the library, so it is rendered once.
         self._system = self.template.render(labels=", ".join(CLASSES),

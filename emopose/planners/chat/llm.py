@@ -16,16 +16,15 @@ untouched as raw contract JSON: validating it is the parse stage's job, the one 
 
 from __future__ import annotations
 
-from typing import Any
-
 from emopose.contract import plan_schema
 from emopose.library import MotionLibrary
+from emopose.llm.client import LLMClient
 from emopose.llm.errors import litellm_module
+from emopose.planners.base import ModalPlanner, PlannerMode
 from emopose.planners.chat.guide import library_guide
 from emopose.planners.chat.planner import ChatPlanner
 from emopose.planners.chat.prompting import PromptError, plan_demonstrations
 
-MODES = ("narrate", "respond")
 STRUCTURED = ("auto", "json_schema", "json_object", "none")
 GUIDES = {"library_guide": "full", "library_names": "short"}  # placeholder -> guide form
 
@@ -43,27 +42,30 @@ def supported_structured_output(model: str) -> str:
     return "json_object" if "response_format" in params else "none"
 
 
-class LLMPlanner(ChatPlanner):
+class LLMPlanner(ChatPlanner, ModalPlanner):
     """mode=narrate: the utterance is the robot's own line (reply = utterance; the benchmarks).
-    mode=respond: the utterance is a person speaking to the robot, which answers (dialogue, tour Q&A)."""
+    mode=respond: the utterance is a person speaking to the robot, which answers (dialogue, tour Q&A).
+    The system prompt offers the live library's motions."""
 
     name = "llm"
 
-    def __init__(self, library: MotionLibrary, template: str, demonstrations: str, mode: str = "narrate",
-                 max_gestures: int = 4, structured_output: str = "auto", **kwargs: Any) -> None:
-        super().__init__(library, template, demonstrations, **kwargs)
-        if mode not in MODES:
-            raise ValueError(f"planner.mode = {mode!r}; choose one of {MODES}")
+    def __init__(self, library: MotionLibrary, client: LLMClient, template: str, demonstrations: str,
+                 mode: str = "narrate", max_gestures: int = 4, structured_output: str = "auto",
+                 max_demonstrations: int | None = None) -> None:
+        super().__init__(client, template, demonstrations, max_demonstrations)
         if not 1 <= max_gestures <= 8:
             raise ValueError(f"planner.max_gestures = {max_gestures} must be in 1..8")
         if structured_output not in STRUCTURED:
             raise ValueError(f"planner.structured_output = {structured_output!r}; choose one of {STRUCTURED}")
-        self.mode, self.max_gestures, self.narrates = mode, int(max_gestures), mode == "narrate"
-        self.template.require("demonstrations", hint="planner=llm goes with prompt=structured or prompt=compact.")
+        self.library, self.mode, self.max_gestures = library, PlannerMode.parse(mode), int(max_gestures)
+        self.narrates = self.mode is PlannerMode.NARRATE
+        self.template.require("demonstrations",
+                              hint="planner=llm goes with prompt=structured or prompt=compact.")
         self._guides = {form for name, form in GUIDES.items() if name in self.template.fields}
         if not self._guides:
-            raise PromptError(f"{self.template.path}: planner=llm needs ${{library_guide}} or ${{library_names}}")
-        self._examples = plan_demonstrations(self.demonstrations, mode)
+            raise PromptError(f"{self.template.path}: planner=llm needs ${{library_guide}} or "
+                              "${library_names}")
+        self._examples = plan_demonstrations(self.demonstrations, self.mode)
         self._structured = structured_output
         self._schema: tuple[int, dict] | None = None  # (library version, schema)
         self.system_prompt()  # render once now, so a template error surfaces at build time
@@ -71,9 +73,10 @@ class LLMPlanner(ChatPlanner):
     def system_prompt(self) -> str:
         # Rendered per request from the cached guide: a variant saved after construction is offered
         # on the very next call (library_guide re-renders when library.version changes).
-        guides = {name: library_guide(self.library, form) for name, form in GUIDES.items() if form in self._guides}
+        guides = {name: library_guide(self.library, form) for name, form in GUIDES.items()
+                  if form in self._guides}
         return self.template.render(**guides, demonstrations=self._examples, max_gestures=self.max_gestures,
-                                    mode=self.mode)
+                                    mode=self.mode.value)
 
     @property
     def structured_output(self) -> str:

@@ -8,10 +8,13 @@ But `abort_after` consecutive failures that no retry can mend (refused connectio
 unknown model, context overflow) raise PlannerFailure: a run stops and names the cause instead
 of scoring the keyword rules as the model. `check()` finds the same causes before the first item.
 
+The model, endpoint, sampling, cache and run limits are one LLMClient, built from the planner's
+`client:` node (conf/llm/hosted.yaml, conf/llm/local_server.yaml): a planner option names which.
+
 Repeated passes: with the cache on, a second pass over the same items must not replay the first.
-While `sampled` (temperature > 0) the cache key holds the draw: `pass_index` (a planner attribute the
-bench job may set before pass k, or `planner.pass_index=K` on the command line) plus how many times
-this planner has already been asked the identical request. Either way five passes are five samples,
+While `sampled` (temperature > 0) the cache key holds the draw: the client's `pass_index` (a job may
+set it before pass k, or `planner.client.pass_index=K` on the command line) plus how many times
+this client has already been asked the identical request. Either way five passes are five samples,
 and rerunning a benchmark in a new process replays them from the cache. At temperature 0 the draw is
 ignored and every pass shares one cached answer.
 """
@@ -21,19 +24,16 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
-import threading
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Coroutine, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
-from emopose.library import MotionLibrary
-from emopose.llm.check import check_context, check_key, check_listening, check_route, probe
+from emopose.llm.check import check_client
 from emopose.llm.client import Completion, LLMClient
 from emopose.llm.counters import CallCounters
-from emopose.llm.errors import LLMCallError
-from emopose.planners.base import PlannerFailure, PlannerOutput, PlanRequest
+from emopose.planners.base import BatchPlanner, CheckedPlanner, PlannerFailure, PlannerOutput, PlanRequest
 from emopose.planners.baselines.keyword import keyword_records
 from emopose.planners.chat.prompting import (
     Demonstration,
@@ -57,30 +57,20 @@ def run_coroutine(coro: Coroutine) -> Any:
         return pool.submit(asyncio.run, coro).result()
 
 
-class ChatPlanner(ABC):
-    """Base class; `**llm` are LLMClient's settings (model, api_base, temperature, cache, ...).
-
-    max_demonstrations: use the first N demonstrations only (None: all). context_window: tokens, for
-    local servers litellm has no card for (None: litellm's model info). probe: send one real request in
-    check(). abort_after: consecutive unmendable call failures that stop a run."""
+class ChatPlanner(CheckedPlanner, BatchPlanner, ABC):
+    """Base class. client: the model, endpoint and run limits (the `client:` node). max_demonstrations:
+    use the first N demonstrations only (None: all)."""
 
     name = "chat"
     narrates = True  # the utterance is the robot's own line (see PlannerOutput.line)
 
-    def __init__(self, library: MotionLibrary, template: str, demonstrations: str, concurrency: int = 16,
-                 pass_index: int = 0, max_demonstrations: int | None = None, context_window: int | None = None,
-                 probe: bool = True, abort_after: int = 5, **llm: Any) -> None:
-        for key, value in (("concurrency", concurrency), ("abort_after", abort_after),
-                           ("max_demonstrations", max_demonstrations), ("context_window", context_window)):
-            if value is not None and value < 1:  # None: all demonstrations / litellm's window
-                raise ValueError(f"planner.{key} = {value} must be >= 1")
-        self.library = library
+    def __init__(self, client: LLMClient, template: str, demonstrations: str,
+                 max_demonstrations: int | None = None) -> None:
+        if max_demonstrations is not None and max_demonstrations < 1:  # None: all demonstrations
+            raise ValueError(f"planner.max_demonstrations = {max_demonstrations} must be >= 1")
+        self.client = client
         self.template = PromptTemplate.load(template)
         self.demonstrations: list[Demonstration] = load_demonstrations(demonstrations)[:max_demonstrations]
-        self.concurrency, self.pass_index = int(concurrency), int(pass_index)
-        self.context_window, self.probe, self.abort_after = context_window, bool(probe), int(abort_after)
-        self.client = LLMClient(**llm)
-        self._unmendable, self._unmendable_lock = 0, threading.Lock()
 
     # -- what subclasses define ------------------------------------------------------------------
     @abstractmethod
@@ -88,7 +78,7 @@ class ChatPlanner(ABC):
         """The rendered system message for the current library."""
 
     def response_format(self) -> dict | None:
-        """litellm's response_format for this planner's answers; None: the prompt alone asks for the format."""
+        """litellm's response_format for this planner's answers; None: the prompt alone asks for it."""
         return None
 
     def to_contract(self, text: str, request: PlanRequest) -> str:
@@ -101,14 +91,7 @@ class ChatPlanner(ABC):
 
     def check(self) -> None:
         """Raise LLMConfigError when the model cannot work (see emopose/llm/check.py)."""
-        if self.probe:
-            check_listening(self.client.api_base)
-        check_route(self.client)
-        check_key(self.client)
-        messages = self.messages(PlanRequest(PROBE_LINE))
-        check_context(self.client, messages, self.context_window)
-        if self.probe:
-            probe(self.client, messages, self.response_format())
+        check_client(self.client, self.messages(PlanRequest(PROBE_LINE)), self.response_format())
 
     def stats(self) -> dict:
         """calls, cache_hits, retries, failed_calls, and model-call latency and queueing mean / p95 (s)."""
@@ -122,7 +105,7 @@ class ChatPlanner(ABC):
         return chat_messages(self.system_prompt(), request)
 
     def plan(self, request: PlanRequest) -> PlannerOutput:
-        pass_index, started = self.pass_index, time.perf_counter()
+        pass_index, started = self.client.pass_index, time.perf_counter()
         try:
             completion = self.client.complete(self.messages(request), pass_index, self.response_format())
             raw = self.to_contract(completion.text, request)
@@ -132,7 +115,7 @@ class ChatPlanner(ABC):
 
     async def aplan(self, request: PlanRequest, gate: asyncio.Semaphore | None = None) -> PlannerOutput:
         """As plan(); latency_s is the model time, not the wait for a concurrency slot."""
-        pass_index = self.pass_index
+        pass_index = self.client.pass_index
         try:
             completion = await self.client.acomplete(self.messages(request), pass_index, gate,
                                                      self.response_format())
@@ -142,10 +125,10 @@ class ChatPlanner(ABC):
         return self._output(request, raw, completion.latency_s, completion, pass_index)
 
     def plan_many(self, requests: Sequence[PlanRequest]) -> list[PlannerOutput]:
-        """All requests concurrently (at most `concurrency` on the wire), answers in request order."""
+        """All requests concurrently (at most client.concurrency on the wire), answers in request order."""
 
         async def run() -> list[PlannerOutput]:
-            gate = asyncio.Semaphore(self.concurrency)
+            gate = asyncio.Semaphore(self.client.concurrency)
             return list(await asyncio.gather(*(self.aplan(r, gate) for r in requests)))
 
         return run_coroutine(run()) if requests else []
@@ -153,30 +136,25 @@ class ChatPlanner(ABC):
     def _line(self, request: PlanRequest) -> str | None:
         return request.utterance if self.narrates else None
 
-    def _count_failure(self, exc: Exception) -> None:
-        """Count a call that failed for good; too many unmendable ones in a row stop the run."""
-        reason = exc.cause if isinstance(exc, LLMCallError) else None
-        with self._unmendable_lock:
-            self._unmendable = self._unmendable + 1 if reason else 0
-            stop = self._unmendable >= self.abort_after
-        if stop:
-            raise PlannerFailure(f"planner {self.name} ({self.client.model}) stopped after {self.abort_after} "
-                                     f"failed calls in a row: {reason}") from exc
-
-    def _fallback(self, request: PlanRequest, exc: Exception, pass_index: int, latency_s: float) -> PlannerOutput:
-        self.client.counters.add(failed_calls=1)
-        self._count_failure(exc)
+    def _fallback(self, request: PlanRequest, exc: Exception, pass_index: int,
+                  latency_s: float) -> PlannerOutput:
+        """The keyword rules' answer, flagged; too many unmendable failures in a row stop the run."""
+        reason = self.client.failed_for_good(exc)
+        if reason is not None:
+            raise PlannerFailure(f"planner {self.name} ({self.client.model}) stopped after "
+                                 f"{self.client.abort_after} failed calls in a row: {reason}") from exc
         error = f"{type(exc).__name__}: {exc}"[:500]
         log.warning("%s planner fell back to keyword rules: %s", self.name, error)
         records = keyword_records(request.utterance)
         raw = json.dumps({"reply": request.utterance, "gestures": [r.as_json() for r in records]})
-        return PlannerOutput(raw=raw, latency_s=latency_s, fallback=True, error=error, line=self._line(request),
-                             meta={"model": self.client.model, "pass_index": pass_index})
+        meta = {"model": self.client.model, "pass_index": pass_index}
+        return PlannerOutput(raw=raw, latency_s=latency_s, fallback=True, error=error,
+                             line=self._line(request), meta=meta)
 
     def _output(self, request: PlanRequest, raw: str, latency_s: float, completion: Completion,
                 pass_index: int) -> PlannerOutput:
-        with self._unmendable_lock:
-            self._unmendable = 0
+        self.client.answered()
         meta = {"model": self.client.model, "pass_index": pass_index, "attempts": completion.attempts,
-                "cached": completion.cached, "finish_reason": completion.finish_reason, "queue_s": completion.queued_s}
+                "cached": completion.cached, "finish_reason": completion.finish_reason,
+                "queue_s": completion.queued_s}
         return PlannerOutput(raw=raw, latency_s=latency_s, meta=meta, line=self._line(request))

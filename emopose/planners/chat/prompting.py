@@ -18,7 +18,7 @@ from pathlib import Path
 from pydantic import ValidationError
 
 from emopose.contract import GestureRecord
-from emopose.planners.base import PlanRequest
+from emopose.planners.base import PlannerMode, PlanRequest
 
 _HEADER_COMMENT = re.compile(r"\A\s*<!--.*?-->\s*", re.DOTALL)
 _IMAGE_MAGIC = {b"\x89PNG": "image/png", b"\xff\xd8\xff": "image/jpeg", b"GIF8": "image/gif",
@@ -53,7 +53,8 @@ class PromptTemplate:
     def require(self, *names: str, hint: str = "") -> PromptTemplate:
         missing = sorted(set(names) - self.fields)
         if missing:
-            raise PromptError(f"{self.path}: this planner needs the placeholders {missing} in its template. {hint}")
+            raise PromptError(f"{self.path}: this planner needs the placeholders {missing} in its template. "
+                              f"{hint}")
         return self
 
     def render(self, **values: object) -> str:
@@ -100,7 +101,7 @@ def load_demonstrations(path: str | Path, key: str = "prompt.demonstrations") ->
     return demos
 
 
-def plan_demonstrations(demos: list[Demonstration], mode: str = "narrate") -> str:
+def plan_demonstrations(demos: list[Demonstration], mode: PlannerMode = PlannerMode.NARRATE) -> str:
     """Examples for the structured prompt: the user message and the exact JSON answer.
 
     A demonstration is a person's message and the robot's annotated reply. In respond mode it is
@@ -109,15 +110,16 @@ def plan_demonstrations(demos: list[Demonstration], mode: str = "narrate") -> st
     """
     shown = []
     for k, d in enumerate(demos, start=1):
-        line = d.text if mode == "respond" else d.reply
+        line = d.text if mode == PlannerMode.RESPOND else d.reply
         shown.append(f"Example {k}\nUser: {line}\nAnswer: {d.plan_json()}")
     return "\n\n".join(shown)
 
 
 def label_demonstrations(demos: list[Demonstration]) -> str:
     """Examples for the direct-label ablation: the same annotated lines, answered with their first class."""
-    return "\n\n".join(f"Example {k}\nUser: {d.reply}\nAnswer: {d.gestures[0].cls if d.gestures else 'neutral'}"
-                       for k, d in enumerate(demos, start=1))
+    labels = (d.gestures[0].cls if d.gestures else "neutral" for d in demos)
+    return "\n\n".join(f"Example {k}\nUser: {d.reply}\nAnswer: {label}"
+                       for k, (d, label) in enumerate(zip(demos, labels), start=1))
 
 
 def dialogue_demonstrations(demos: list[Demonstration]) -> str:

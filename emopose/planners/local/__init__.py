@@ -1,1 +1,2 @@
-"""The embedded offline planner: a fine-tuned sentence encoder with segmentation, class, variant and relevance heads."""
+"""The embedded offline planner: a fine-tuned sentence encoder with segmentation, class, variant and
+relevance heads."""

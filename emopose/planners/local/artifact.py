@@ -1,9 +1,10 @@
 """The trained local planner on disk: one file per (training files' contents, TrainingConfig), cached.
 
-`train_artifact` is the training job: `python -m emopose +experiment=train_local` runs it explicitly
-(retrain=True to replace a cached file), and the planner's first use calls it when its artifact is
-missing. `load_model` only loads. The library's motion descriptions supervise the variant projections
-but are not part of the key: editing a description does not force a retrain.
+Training runs only where it is asked for: `python -m emopose +experiment=train_local` (job.retrain=true
+replaces a cached file), or `train_missing_artifact`, the first-use step LocalPlanner.from_config takes
+when planner.train_if_missing is true. `cached_artifact` and `load_model` only find and load. The
+library's motion descriptions supervise the variant projections but are not part of the key: editing a
+description does not force a retrain.
 """
 
 from __future__ import annotations
@@ -32,17 +33,13 @@ def artifact_path(paths: list[str], cache_dir: str | Path, config: TrainingConfi
 
 
 def train_artifact(paths: list[str], cache_dir: str | Path, config: TrainingConfig,
-                   catalogue: dict[str, tuple[str, str]], retrain: bool = False,
-                   progress: bool = True) -> Path:
-    """Train on the training files (held-out slice excluded) and save. A cached artifact for the same
-    files and config is returned as it is unless retrain."""
+                   catalogue: dict[str, tuple[str, str]], progress: bool = True) -> Path:
+    """Train on the training files (held-out slice excluded) and save, replacing any cached file."""
     import torch
 
     from emopose.planners.local.training import fit
 
     artifact = artifact_path(paths, cache_dir, config)
-    if artifact.is_file() and not retrain:
-        return artifact
     log.warning("training the local planner on %s (cached at %s)", [Path(p).name for p in paths], artifact)
     model = ActModel(config)
     examples = load_examples(paths, config.holdout_percent, synthetic=config.synthetic_sequences,
@@ -52,6 +49,27 @@ def train_artifact(paths: list[str], cache_dir: str | Path, config: TrainingConf
     tmp = artifact.with_suffix(".tmp")
     torch.save(model.state(), tmp)
     tmp.replace(artifact)
+    return artifact
+
+
+def train_missing_artifact(paths: list[str], cache_dir: str | Path, config: TrainingConfig,
+                           catalogue: dict[str, tuple[str, str]]) -> Path:
+    """The first-use step (planner.train_if_missing: true): train the artifact when none is cached."""
+    artifact = artifact_path(paths, cache_dir, config)
+    if not artifact.is_file():
+        log.warning("planner.train_if_missing: no trained local planner at %s, training it before the run "
+                    "(`python -m emopose +experiment=train_local` trains it ahead)", artifact)
+        train_artifact(paths, cache_dir, config, catalogue)
+    return artifact
+
+
+def cached_artifact(paths: list[str], cache_dir: str | Path, config: TrainingConfig) -> Path:
+    """The cached artifact for these files and config; none is an error saying how to train one."""
+    artifact = artifact_path(paths, cache_dir, config)
+    if not artifact.is_file():
+        raise ValueError(f"no trained local planner at {artifact} for these training files and "
+                         "planner.training: train it with `python -m emopose +experiment=train_local`, "
+                         "or set planner.train_if_missing=true to train it on first use")
     return artifact
 
 

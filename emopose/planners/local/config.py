@@ -1,15 +1,18 @@
-"""The local planner's training hyper-parameters, validated where they enter (planner.training).
+"""The local planner's settings (planner.*) and training hyper-parameters (planner.training), validated
+where they enter.
 
-Their values live in one place, conf/planner/local.yaml; this model only checks them, so every field
-is required (a missing one is an error naming it). Every field is part of the trained artifact's cache
-key (planners/local_artifact.py): changing one trains a new model, the old artifact stays on disk.
+Their values live in one place, conf/planner/local.yaml; these models only check them, so every field
+is required (a missing one is an error naming it). Every TrainingConfig field is part of the trained
+artifact's cache key (planners/local/artifact.py): changing one trains a new model, the old artifact
+stays on disk.
 """
 
 from __future__ import annotations
 
-from typing import Literal
+import math
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
 
 class TrainingConfig(BaseModel):
@@ -33,3 +36,35 @@ class TrainingConfig(BaseModel):
     split_loss_weight: float = Field(ge=0)  # the semi-CRF likelihood of the annotated split
     relevance_loss_weight: float = Field(ge=0)  # whether a history bears on the utterance (distractors: no)
     seed: int
+
+
+def _not_nan(value: float) -> float:
+    if math.isnan(value):
+        raise ValueError("must be a number (-.inf keeps every history), not NaN")
+    return value
+
+
+FiniteWeight = Annotated[float, Field(ge=0, allow_inf_nan=False)]  # 0: the term counts nothing
+
+
+class LocalSettings(BaseModel):
+    """planner.* of conf/planner/local.yaml (what LocalPlanner reads); their meaning is documented there."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True)
+
+    train_files: list[str]
+    cache_dir: str
+    training: TrainingConfig
+    temperature: float = Field(gt=0)  # the class logits' divisor in the split
+    boundary_weight: float
+    act_cost: float
+    min_words: int = Field(ge=0)
+    max_records: int = Field(ge=0)
+    variant_word_weight: FiniteWeight
+    variant_shared_weight: FiniteWeight
+    variant_pretrained_share: float = Field(ge=0, le=1)
+    variant_class_weight: FiniteWeight
+    variant_class_weight_new: FiniteWeight
+    history_threshold: Annotated[float, AfterValidator(_not_nan)]
+    bf16_inference: bool
+    trace_inference: bool

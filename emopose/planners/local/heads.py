@@ -77,7 +77,8 @@ def new_heads(width: int) -> tuple:
     """(act head, boundary head, anchor head, relevance head), freshly initialised (seed first)."""
     import torch
 
-    act = torch.nn.Linear(width, len(CLASSES))  # created in this order: the seeded initialisation depends on it
+    # created in this order: the seeded initialisation depends on it
+    act = torch.nn.Linear(width, len(CLASSES))
     boundary = torch.nn.Sequential(torch.nn.Linear(4 * width, 64), torch.nn.ReLU(), torch.nn.Linear(64, 1))
     anchor = torch.nn.Linear(width, 1)
     relevance = torch.nn.Linear(width, 1)

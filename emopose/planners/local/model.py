@@ -15,7 +15,7 @@ kept; their character starts are relative to the utterance. One forward pass giv
   through small trained projections, so a new or edited motion is scored like a known one.
 
 Inference (bf16, traced) is planners/local_inference.py, training planners/local_training.py, the
-cached artifact planners/local_artifact.py.
+cached artifact planners/local/artifact.py.
 """
 
 from __future__ import annotations
@@ -86,7 +86,8 @@ class ActModel:
 
     @property
     def heads(self) -> list:
-        return [self.act_head, self.boundary_head, self.anchor_head, self.relevance_head, *self.variant_projections]
+        return [self.act_head, self.boundary_head, self.anchor_head, self.relevance_head,
+                *self.variant_projections]
 
     @property
     def frozen_depth(self) -> int:
@@ -120,7 +121,8 @@ class ActModel:
     def input_lengths(self, texts: list[str], histories: Sequence[Sequence[dict]]) -> list[int]:
         """Tokens each input (history prefix and text) takes: what its batch is padded to."""
         inputs = [context_prefix(h) + t for t, h in zip(texts, histories)]
-        return [len(ids) for ids in self.tokenizer(inputs, truncation=True, max_length=MAX_TOKENS)["input_ids"]]
+        input_ids = self.tokenizer(inputs, truncation=True, max_length=MAX_TOKENS)["input_ids"]
+        return [len(ids) for ids in input_ids]
 
     def learn_words(self, texts: list[str]) -> None:
         """Each vocabulary token's relative frequency in the texts (the training split's utterances)."""
@@ -131,7 +133,7 @@ class ActModel:
         self.word_frequency = counts.float() / max(1, len(ids))
 
     def words(self, inputs: dict):
-        """(B, T, D): the word embeddings of the input tokens (the lexical states; no position, no context)."""
+        """(B, T, D): the input tokens' word embeddings (the lexical states; no position, no context)."""
         return self.body.embeddings.word_embeddings(inputs["input_ids"])
 
     def word_weights(self, inputs: dict):

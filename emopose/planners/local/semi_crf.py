@@ -33,7 +33,8 @@ def log_partition(n: int, spans: list[Span], span_scores, openings):
         by_end.setdefault(j, []).append(k)
     alpha = None
     for j in range(1, n + 1):
-        alpha = torch.logsumexp(torch.stack([entering[spans[k][0]] + span_scores[k] for k in by_end[j]]), dim=0)
+        alpha = torch.logsumexp(torch.stack([entering[spans[k][0]] + span_scores[k] for k in by_end[j]]),
+                                dim=0)
         if j < n:
             entering[j] = torch.logsumexp(alpha.unsqueeze(0) + differ, dim=1) + openings[j - 1]
     return torch.logsumexp(alpha, dim=0)
@@ -48,7 +49,8 @@ def split_score(acts: list[tuple[int, int]], spans: list[Span], span_scores, ope
     return total
 
 
-def best_split(n: int, spans: list[Span], span_scores: np.ndarray, openings: np.ndarray) -> list[tuple[int, int]]:
+def best_split(n: int, spans: list[Span], span_scores: np.ndarray,
+               openings: np.ndarray) -> list[tuple[int, int]]:
     """The highest-scoring split as (span index, class index) per act, in order."""
     classes = span_scores.shape[1]
     # best[j][c]: score of the best split of segments[:j] whose last act has class c.

@@ -26,7 +26,7 @@ similarity, keeps part of the dense terms free of that. The shared-word term cou
 texts say, so it adds nothing for descriptions that merely sound alike (the averaged distinctive vectors
 do; leaning on the shared words, known motions lose fewer acts to new ones). The projections read only
 frozen states, so they are trained apart from the encoder, in seconds, after its epochs
-(planners/local_training.py).
+(planners/local/variant_training.py).
 
 The class is chosen with the motion (VariantChooser.choose): a motion of another class that fits the act
 better than its own class's best can move it, by log p(class) + w * (the score margin); w is larger for a
@@ -35,8 +35,6 @@ motion the training data never annotated, whose uses the class head cannot know.
 
 from __future__ import annotations
 
-import random
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -68,11 +66,6 @@ def unit(projection, vectors):
     return normalize(projection(vectors), dim=-1)
 
 
-def similarity(projection, acts, motions):
-    """(A, M) cosine similarity of A act vectors and M motion vectors after the projection (torch)."""
-    return unit(projection, acts) @ unit(projection, motions).T
-
-
 @dataclass
 class Features:
     """What the variant score reads of N texts (acts or descriptions)."""
@@ -83,14 +76,16 @@ class Features:
     words: list[tuple[np.ndarray, np.ndarray]]  # per text: (token ids, rarity weights)
 
     def __getitem__(self, k: int) -> Features:
-        return Features(self.semantic[k:k + 1], self.lexical[k:k + 1], self.distinctive[k:k + 1], [self.words[k]])
+        return Features(self.semantic[k:k + 1], self.lexical[k:k + 1], self.distinctive[k:k + 1],
+                        [self.words[k]])
 
     @classmethod
     def stacked(cls, parts: list[Features], width: int) -> Features:
         if not parts:
             return cls(*(np.zeros((0, width), dtype=np.float32) for _ in range(3)), [])
-        return cls(*(np.concatenate([getattr(p, name) for p in parts]) for name in ("semantic", "lexical", "distinctive")),
-                   [w for p in parts for w in p.words])
+        dense = (np.concatenate([getattr(p, name) for p in parts])
+                 for name in ("semantic", "lexical", "distinctive"))
+        return cls(*dense, [w for p in parts for w in p.words])
 
 
 @dataclass
@@ -148,65 +143,6 @@ def scores(act: Compared, motions: Compared, weights: Weights) -> np.ndarray:
     dense = (1 - q) * trained + q * pretrained + weights.word * act.distinctive @ motions.distinctive.T
     shared = np.stack([shared_words(words, motions.words) for words in act.words])
     return dense.numpy() + weights.shared * shared
-
-
-@dataclass
-class AnnotatedAct:
-    """One training act with an annotated variant: its class, motion and (semantic, lexical) vectors."""
-
-    label: str
-    variant: str
-    semantic: object  # torch (D,)
-    lexical: object  # torch (D,)
-
-
-def fit_variants(projections, acts: list[AnnotatedAct], described: dict[str, tuple], cfg,
-                 progress: bool = True) -> None:
-    """Train the projections in place: cross-entropy of each act's annotated motion against the other
-    motions of its class that are not left out of the batch (cfg.variant_holdout of each class's
-    motions, drawn per batch), for each projection's own similarity. described: motion name ->
-    (class, semantic (D,), lexical (D,))."""
-    import torch
-    from tqdm import tqdm
-
-    names = [n for n in described if sum(described[m][0] == described[n][0] for m in described) > 1]
-    acts = [a for a in acts if a.variant in names]
-    if not acts:
-        return
-    motion_class = [CLASSES.index(described[n][0]) for n in names]
-    motion_semantic = torch.stack([described[n][1] for n in names])
-    motion_lexical = torch.stack([described[n][2] for n in names])
-    members = {c: [k for k, m in enumerate(motion_class) if m == c] for c in set(motion_class)}
-    act_class = torch.tensor([CLASSES.index(a.label) for a in acts])
-    target = torch.tensor([names.index(a.variant) for a in acts])
-    act_semantic = torch.stack([a.semantic for a in acts])
-    act_lexical = torch.stack([a.lexical for a in acts])
-    same_class = act_class.unsqueeze(1) == torch.tensor(motion_class).unsqueeze(0)  # (A, M)
-    channels = ((projections[0], act_semantic, motion_semantic), (projections[1], act_lexical, motion_lexical))
-    rng = random.Random(cfg.seed)
-    generator = torch.Generator().manual_seed(cfg.seed)
-    optimizer = torch.optim.AdamW([q for p in projections for q in p.parameters()], lr=cfg.head_lr,
-                                  weight_decay=0.01)
-    for _ in tqdm(range(cfg.variant_epochs), desc="local planner: variant projections", unit="epoch",
-                  file=sys.stderr, disable=not progress):
-        for batch in torch.randperm(len(acts), generator=generator).split(cfg.batch_size):
-            left_out = torch.zeros(len(names), dtype=torch.bool)
-            for ks in members.values():
-                left_out[rng.sample(ks, round(cfg.variant_holdout * len(ks)))] = True
-            allowed = same_class[batch] & ~left_out
-            # an act whose motion is left out, or that would have no competitor, teaches nothing here
-            kept = allowed[torch.arange(len(batch)), target[batch]] & (allowed.sum(1) > 1)
-            if not kept.any():
-                continue
-            rows = batch[kept]
-            # each projection learns on its own: trained together, one leaned on the other (held-out
-            # exact variant 62 % against 64 %)
-            loss = sum(torch.nn.functional.cross_entropy(
-                (similarity(projection, acts_in[rows], motions) * cfg.logit_scale).masked_fill(~allowed[kept], -1e4),
-                target[rows]) for projection, acts_in, motions in channels)
-            optimizer.zero_grad()
-            loss.backward()
-            optimizer.step()
 
 
 @dataclass(frozen=True)

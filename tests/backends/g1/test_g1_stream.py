@@ -39,6 +39,7 @@ def run(module_fake_robot, domain_id, tmp_path_factory):
         neutral_pose=NEUTRAL.tolist(),
     )
     q0 = backend.connect(recorder)
+    connected = backend.is_connected
     k = np.arange(N)[:, None]
     traj = (
         q0[None, :]
@@ -47,10 +48,11 @@ def run(module_fake_robot, domain_id, tmp_path_factory):
     traj[-1, 3] = 3.0  # beyond the elbow's upper limit 2.0944: must arrive clamped
     clock = MonotonicClock()
     deadline = clock.now()
+    sent = []
     for i, q in enumerate(traj):
         deadline += 0.02
         clock.sleep_until(deadline)
-        backend.send(i * 0.02, q)
+        sent.append(backend.send(i * 0.02, q))
     measured = backend.measured()
     backend.close()
     before = len(robot.wait_for("arm", 10**6, timeout_s=0.5))  # let the release land
@@ -67,10 +69,17 @@ def run(module_fake_robot, domain_id, tmp_path_factory):
         "expected": expected,
         "arm": robot.entries("arm"),
         "measured": measured,
+        "sent": np.array(sent),
+        "connected": (connected, backend.is_connected),
         "second_close_sent": total - before,
         "recording": read_recording(path),
         "backend": backend,
     }
+
+
+def test_send_returns_the_clamped_targets_and_is_connected_follows_the_session(run):
+    np.testing.assert_allclose(run["sent"], run["expected"])  # the last one clamped at the elbow's limit
+    assert run["connected"] == (True, False)
 
 
 def test_connect_returns_the_measured_pose(run):

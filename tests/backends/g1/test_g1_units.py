@@ -43,7 +43,7 @@ def test_settings_errors_name_the_field(kwargs, field):
 
 def test_lifecycle_without_connect():
     backend = G1Backend()
-    assert backend.measured() is None
+    assert backend.measured() is None and not backend.is_connected
     with pytest.raises(G1BackendError, match="before connect"):
         backend.send(0.0, np.zeros(14))
     backend.close()
