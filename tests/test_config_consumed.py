@@ -95,7 +95,7 @@ CONSUMERS = {
     "safety": safety_hook,
     "sequencer": lambda cfg, run: built_from(cfg.sequencer, run.resources.sequencer, "blend_s", "hold_s",
                                              "recover_s", "interrupt_blend_s", "neutral_tolerance",
-                                             "preempt_after_s"),
+                                             "preempt_after_s", "stall_stop_late_s"),
     "asr": lambda cfg, run: built_from(cfg.asr, run.resources.asr, "model", "api_base", "language"),
     "player": lambda cfg, run: built_from(cfg.player, run.resources.player, "sink", "latency_s"),
     "thinking": lambda cfg, run: built_from(cfg.thinking, run.runner.thinking, "motion", "repeats"),

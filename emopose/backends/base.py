@@ -28,7 +28,8 @@ class Backend(ABC):
     @abstractmethod
     def connect(self, recorder: Recorder | None) -> np.ndarray | None:
         """Open the connection; return the measured 14-DoF pose to start from, or None when the
-        backend cannot measure (the run then starts from the library's neutral pose)."""
+        backend cannot measure or has not been placed yet (MuJoCo without `initial_pose` is placed
+        at the stream's first command): the run then starts from the library's neutral pose."""
 
     @abstractmethod
     def send(self, t: float, q: np.ndarray) -> np.ndarray:

@@ -63,9 +63,9 @@ class MujocoBackend(Backend):
             )
         self.model_path = model_path
         self.substeps, self.timestep = substeps, timestep
-        self.initial_pose = (
-            np.zeros(NUM_JOINTS) if initial_pose is None else np.asarray(initial_pose, float)
-        )
+        # None: like dry_run, the run starts from the library's neutral pose (the session's stream start);
+        # the arms are placed at the stream's first command, so nothing moves from a pose nobody chose.
+        self.initial_pose = None if initial_pose is None else np.asarray(initial_pose, float)
         # Built without a law (code, not config): the servos as the model file declares them.
         self.law = law or ArmLaw("mjcf", None, None, velocity_feedforward=True, gravity_compensation=True)
         self.tracking_lag_s = tracking_lag_s
@@ -79,6 +79,7 @@ class MujocoBackend(Backend):
         self._lock = threading.RLock()
         self._viewer = None
         self._tick = 0
+        self._placed = False  # the arms stand where a caller (initial_pose, reset, first send) put them
         self._connected = False
 
     def select_gl(self) -> bool:
@@ -117,11 +118,9 @@ class MujocoBackend(Backend):
         self._mjcf_gravcomp = (m.body_gravcomp.copy(), m.jnt_actgravcomp.copy())
         self._gravity: GravityModel | None = None  # built the first time a law asks for a gravity torque
         self.apply_law(self.law)
-        q0 = np.clip(self.initial_pose, self._lo, self._hi)
-        self.data.qpos[self._qadr] = q0
-        self.data.ctrl[self._act] = q0
-        self._feedforward.reset(q0)
-        mujoco.mj_forward(m, self.data)
+        self._placed = False
+        if self.initial_pose is not None:
+            self._place(self.initial_pose)
         self._recorder, self._tick = recorder, 0
         self.max_actuator_force_ratio = 0.0
         self.renderer.attach(m, self.data, self._lock)
@@ -132,13 +131,15 @@ class MujocoBackend(Backend):
 
             self._viewer = mujoco.viewer.launch_passive(m, self.data)
         self._connected = True
-        return self.measured()
+        return self.measured()  # None until placed: the session then starts from the library's neutral
 
     def send(self, t: float, q: np.ndarray) -> np.ndarray:
         """One control period of physics toward q clipped to the joints' ranges; returns that target."""
         if self.data is None:
             raise RuntimeError("mujoco backend: send() before connect()")
         target = np.clip(np.asarray(q, dtype=float).reshape(NUM_JOINTS), self._lo, self._hi)
+        if not self._placed:
+            self._place(target)
         dq, tau = self._feedforward(target)
         # A position servo makes kp (ctrl - q) - kv qd, so the robot's kp (q* - q) + kd (dq* - qd) + tau_ff
         # is ctrl = q* + (kd dq* + tau_ff) / kp.
@@ -191,18 +192,26 @@ class MujocoBackend(Backend):
         checks and replays start each run from a known pose without reconnecting."""
         if self.data is None:
             raise RuntimeError("mujoco backend: reset() before connect()")
-        q = np.clip(np.asarray(q, dtype=float).reshape(NUM_JOINTS), self._lo, self._hi)
         with self._lock:
             self._mj.mj_resetData(self.model, self.data)
-            self.data.qpos[self._qadr] = q
-            self.data.ctrl[self._act] = q
-            self._mj.mj_forward(self.model, self.data)
-        self._feedforward.reset(q)
+            self._place(q)
         self.max_actuator_force_ratio = 0.0
         return self.measured()
 
+    def _place(self, q: np.ndarray) -> None:
+        """The arms at rest at q (clipped to range), the servos holding it; the rest of the state as is."""
+        q = np.clip(np.asarray(q, dtype=float).reshape(NUM_JOINTS), self._lo, self._hi)
+        with self._lock:
+            self.data.qpos[self._qadr] = q
+            self.data.qvel[self._dadr] = 0.0
+            self.data.ctrl[self._act] = q
+            self._mj.mj_forward(self.model, self.data)
+        self._feedforward.reset(q)
+        self._placed = True
+
     def measured(self) -> np.ndarray | None:
-        if self.data is None:
+        """The simulated arm pose; None before connect() or (no initial_pose) before the first command."""
+        if self.data is None or not self._placed:
             return None
         with self._lock:
             return self.data.qpos[self._qadr].copy()

@@ -5,16 +5,22 @@ Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt
 that passed a whole period ago, or before the previous command went out, are skipped, not sent in a
 burst: after a stall (or while nobody drove the loop, e.g. the planner was thinking) the loop
 re-anchors on its grid and counts what it skipped; and no command follows the previous one by less
-than half a period. The sequencer plays its samples tick by tick, so a skip delays a motion, never jumps it.
+than half a period. The sequencer samples its motions on the clock and re-times a running gesture after
+a skip (within the speed bound), so a stall never jumps the arm and need not delay the stroke.
 With a FakeClock the same loop renders a run as fast as the CPU allows; with MonotonicClock it is
 real time. `run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background
 thread for the web UI, speech and the tour; `wait_until()` waits the right way for either.
+Served, the loop shares its process with the web server, rendering, planning and synthesis; `start(
+rt_priority)` puts its thread in SCHED_FIFO (else at a negative nice, else as it was, with one log line) and
+shortens Python's thread switch interval, so neither the OS nor the GIL keeps it waiting for long.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+import os
+import sys
 import threading
 import time
 from collections import deque
@@ -32,6 +38,27 @@ from emopose.recording import Recorder
 
 log = logging.getLogger(__name__)
 
+FALLBACK_NICE = -10  # where SCHED_FIFO is refused but raising the thread's nice value is allowed
+RT_SWITCH_INTERVAL_S = 0.0005  # GIL hand-over interval while the loop runs on its thread (Python: 5 ms)
+
+
+def raise_thread_priority(priority: int) -> str:
+    """Ask the OS to run the calling thread first: SCHED_FIFO at `priority` (1-99), else nice
+    FALLBACK_NICE. Where neither is permitted (no CAP_SYS_NICE, a container, not Linux) the thread keeps
+    its scheduling and one log line says so. Returns what the thread got."""
+    thread = threading.get_native_id()
+    try:
+        os.sched_setscheduler(thread, os.SCHED_FIFO, os.sched_param(priority))
+        return f"SCHED_FIFO {priority}"
+    except (AttributeError, OSError):
+        pass
+    try:
+        os.setpriority(os.PRIO_PROCESS, thread, FALLBACK_NICE)  # Linux: a thread id sets that thread only
+        return f"nice {FALLBACK_NICE}"
+    except (AttributeError, OSError) as exc:
+        log.warning("control loop: real-time priority not permitted (%s); normal scheduling", exc)
+        return "normal"
+
 
 @dataclass
 class LoopStats:
@@ -43,6 +70,7 @@ class LoopStats:
     missed_deadlines: int = 0  # deadlines skipped because the loop fell behind while it was driven
     stalls: int = 0  # how often it fell behind by a whole period and re-anchored
     idle_ticks: int = 0  # deadlines skipped while nobody drove the loop (between run_until calls)
+    scheduling: str = "normal"  # what the loop thread got from the OS (see raise_thread_priority)
     lateness_max_s: float = 0.0
     lateness_s: deque[float] = field(init=False, repr=False)
 
@@ -55,9 +83,11 @@ class LoopStats:
         self.lateness_max_s = max(self.lateness_max_s, lateness)
 
     def summary(self) -> dict:
-        late = np.asarray(self.lateness_s or [0.0]) * 1e3
+        # list() copies in one C call while the loop thread may append (web status reads it live)
+        late = np.asarray(list(self.lateness_s) or [0.0]) * 1e3
         return {"ticks": self.ticks, "missed_deadlines": self.missed_deadlines, "stalls": self.stalls,
-                "idle_ticks": self.idle_ticks, "lateness_ms_p50": float(np.percentile(late, 50)),
+                "missed_per_tick": self.missed_deadlines / max(self.ticks, 1), "idle_ticks": self.idle_ticks,
+                "scheduling": self.scheduling, "lateness_ms_p50": float(np.percentile(late, 50)),
                 "lateness_ms_p99": float(np.percentile(late, 99)),
                 "lateness_ms_max": self.lateness_max_s * 1e3}
 
@@ -72,6 +102,8 @@ class ControlLoop:
         self._last_sent = -np.inf  # clock time the previous command went out
         self._resuming = True  # nobody drove the loop since the last tick: lag is idle time, not a stall
         self._worker = Worker("emopose-control", self._run, join_timeout_s=2.0)
+        self._rt_priority = 0
+        self._saved_switch_interval: float | None = None
         self.error: BaseException | None = None
 
     def begin(self, q0: np.ndarray, recorder: Recorder | None = None) -> None:
@@ -145,10 +177,18 @@ class ControlLoop:
         return False
 
     # -- background thread ---------------------------------------------------------------------
-    def start(self) -> None:
+    def start(self, rt_priority: int = 0) -> None:
+        """Run the loop on its thread; rt_priority > 0 (run.rt_priority, real-time runs) raises the thread's
+        scheduling and hands the GIL over every RT_SWITCH_INTERVAL_S until stop()."""
+        self._rt_priority = rt_priority
+        if rt_priority > 0 and self._saved_switch_interval is None:
+            self._saved_switch_interval = sys.getswitchinterval()
+            sys.setswitchinterval(RT_SWITCH_INTERVAL_S)
         self._worker.start()
 
     def _run(self, stop: threading.Event) -> None:
+        if self._rt_priority > 0:
+            self.stats.scheduling = raise_thread_priority(self._rt_priority)
         try:
             while not stop.is_set():
                 self.tick()
@@ -158,6 +198,9 @@ class ControlLoop:
 
     def stop(self) -> None:
         self._worker.stop()
+        if self._saved_switch_interval is not None:
+            sys.setswitchinterval(self._saved_switch_interval)
+            self._saved_switch_interval = None
 
     @property
     def running(self) -> bool:

@@ -39,7 +39,15 @@ class GestureCommand:
 
 
 class State(StrEnum):
-    """The sequencer's state (its docstring draws the transitions)."""
+    """The sequencer's state. Its transitions (emopose/execution/sequencer.py):
+
+    IDLE/HOLDING --released command--> EXECUTING (trajectory built from the latest published pose)
+    EXECUTING --done, successor released--> BLENDING (cubic, <= blend_s) --> EXECUTING
+    EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> BLENDING to neutral
+                                                    (recover_s) --> IDLE
+    any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
+    EXECUTING --stall, stroke too late--> BLENDING to neutral (recover_s)
+    """
 
     IDLE = "idle"
     EXECUTING = "executing"

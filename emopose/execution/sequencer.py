@@ -1,10 +1,5 @@
 """The robot-side gesture sequencer (paper Fig. sequencer): one active trajectory, a FIFO queue.
-
-IDLE/HOLDING --released command--> EXECUTING (trajectory built from the latest published pose)
-EXECUTING --done, successor released--> BLENDING (cubic, <= blend_s) --> EXECUTING
-EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> BLENDING to neutral
-                                                (recover_s) --> IDLE
-any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
+Its states and their transitions: State (gesture_command.py).
 Beyond the paper (off by default): with `preempt_after_s` set, a queued command whose release time has
 passed by that much cuts the running motion short with a normal blend, so long motions do not push
 later gestures away from their words (-blend_s: the successor begins on its word).
@@ -18,6 +13,10 @@ one starts at its release time from the pose published then (no blend in front: 
 own transition), preempting (CUT) a motion still running, and its trajectory meets the keyframe
 times, lengthening only what the speed bound forbids. Events: EventKind (gesture_command.py); STROKE
 is the arm within STROKE_TOLERANCE of the stroke-start keyframe.
+
+Motions are sampled on the clock (sample n at start + n * dt). After a stall (skipped ticks) a running
+gesture catches up (TrajectoryBuilder.catch_up), one sample per tick, never a jump; one whose stroke would
+still be over `stall_stop_late_s` late is STOPPED (detail: how late) and the arm recovers toward neutral.
 """
 
 from __future__ import annotations
@@ -39,27 +38,17 @@ SafetyCheck = Callable[[np.ndarray], "str | None"]
 
 
 class Sequencer:
-    def __init__(
-        self,
-        builder: TrajectoryBuilder,
-        neutral: np.ndarray,
-        safety: SafetyCheck | None = None,
-        blend_s: float = 0.3,
-        hold_s: float = 2.0,
-        recover_s: float = 1.0,
-        interrupt_blend_s: float = 0.3,
-        neutral_tolerance: float = 0.02,
-        preempt_after_s: float | None = None,
-        on_event: Callable[[Event], None] | None = None,
-        keep_events: int = 10_000,
-    ) -> None:
+    def __init__(self, builder: TrajectoryBuilder, neutral: np.ndarray, safety: SafetyCheck | None = None,
+                 blend_s: float = 0.3, hold_s: float = 2.0, recover_s: float = 1.0,
+                 interrupt_blend_s: float = 0.3, neutral_tolerance: float = 0.02,
+                 preempt_after_s: float | None = None, stall_stop_late_s: float = 0.5,
+                 on_event: Callable[[Event], None] | None = None, keep_events: int = 10_000) -> None:
         self.builder = builder
         self.neutral = np.asarray(neutral, dtype=float)
         self.safety = safety
         self.blend_s, self.hold_s, self.recover_s = blend_s, hold_s, recover_s
-        self.interrupt_blend_s = interrupt_blend_s
-        self.neutral_tolerance = neutral_tolerance
-        self.preempt_after_s = preempt_after_s
+        self.interrupt_blend_s, self.neutral_tolerance = interrupt_blend_s, neutral_tolerance
+        self.preempt_after_s, self.stall_stop_late_s = preempt_after_s, stall_stop_late_s
         self.on_event = on_event
         self.events: BoundedLog[Event] = BoundedLog(keep_events)
         self.construction_s: BoundedLog[float] = BoundedLog(keep_events)
@@ -74,7 +63,7 @@ class Sequencer:
             self.state = State.IDLE
             self._queue.clear()
             self._motion: Trajectory | None = None
-            self._index = 0
+            self._index, self._motion_t0 = 0, now
             self._active: GestureCommand | None = None
             self._after_blend: GestureCommand | None = None
             self._stroke_tick = -1
@@ -110,12 +99,10 @@ class Sequencer:
         """Move the release of the queued commands in `ids` by delta seconds (their speech started that much
         later than planned); returns how many moved. Commands already running are not touched."""
         with self._lock:
-            moved = 0
-            for k, command in enumerate(self._queue):
-                if command.id in ids:
-                    self._queue[k] = replace(command, release_at=command.release_at + delta)
-                    moved += 1
-            return moved
+            moved = [k for k, command in enumerate(self._queue) if command.id in ids]
+            for k in moved:
+                self._queue[k] = replace(self._queue[k], release_at=self._queue[k].release_at + delta)
+            return len(moved)
 
     @property
     def pending(self) -> list[GestureCommand]:
@@ -152,6 +139,9 @@ class Sequencer:
 
     # -- internals (lock held) -----------------------------------------------------------------
     def _advance(self, now: float) -> None:
+        due = round((now - self._motion_t0) / self.builder.dt)  # the sample this tick stands for
+        if self.state == State.EXECUTING and due > self._index + 1 and not self._catch_up(now, due):
+            return
         self._index += 1
         self.last = self._motion.samples[self._index].copy()
         if self._index == self._stroke_tick and self.state == State.EXECUTING:
@@ -180,6 +170,20 @@ class Sequencer:
         else:
             self._set_state(now, State.IDLE)
 
+    def _catch_up(self, now: float, due: int) -> bool:
+        """Re-time the running gesture after a stall (its next sample is this tick's); False when it was
+        stopped instead, because its stroke would come more than stall_stop_late_s late."""
+        motion, dt = self.builder.catch_up(self._motion, self._index, due - 1), self.builder.dt
+        ahead = self._stroke_tick > self._index  # else reported already, or none
+        stroke_tick = motion.arrival_tick(self._active.keyframes, self._active.stroke[0]) if ahead else -1
+        late = (stroke_tick + due - 1 - self._stroke_tick) * dt
+        if ahead and late > self.stall_stop_late_s:
+            self._emit(now, EventKind.STOPPED, self._active, f"stall: stroke {late * 1e3:.0f} ms late")
+            self._start_blend(now, self.neutral, self.recover_s, None)
+            return False
+        self._motion, self._index, self._motion_t0, self._stroke_tick = motion, 0, now - dt, stroke_tick
+        return True
+
     def _timed_head_due(self, now: float) -> bool:
         return bool(self._queue) and self._queue[0].timed and self._queue[0].release_at <= now
 
@@ -207,7 +211,7 @@ class Sequencer:
         if reason is not None:
             self._emit(now, EventKind.REJECTED, command, reason)
             return False
-        self._motion, self._index, self._active = motion, 0, command
+        self._motion, self._index, self._motion_t0, self._active = motion, 0, now, command
         stroke = command.stroke
         self._stroke_tick = -1 if stroke is None else motion.arrival_tick(command.keyframes, stroke[0])
         self._set_state(now, State.EXECUTING)
@@ -223,7 +227,7 @@ class Sequencer:
     def _start_blend(self, now: float, target: np.ndarray, duration: float,
                      then: GestureCommand | None) -> None:
         self._motion = self.builder.blend(self.last, target, duration)
-        self._index, self._active, self._after_blend = 0, None, then
+        self._index, self._motion_t0, self._active, self._after_blend = 0, now, None, then
         self._set_state(now, State.BLENDING)
 
     def _recover(self, now: float) -> None:

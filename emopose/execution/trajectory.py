@@ -13,6 +13,11 @@ until it does not; `stretch` reports the factor. Blends get the same treatment.
 Timed construction (the timeline): each keyframe has its own time, so segments differ in length; a
 segment too short for the speed bound is lengthened and everything after it moves later (`late_s`).
 The first segment of a co-articulated gesture eases with the cubic blend beta instead of the smoothstep.
+
+Catching up (beyond the paper): a motion left behind by a stall (the loop did not tick) is rebuilt from
+where the arm stands to the keyframes it has not reached, each on the tick it was built for, lengthening
+only what the speed bound forbids; so a stroke still lands on its time when the bound allows. The arm
+stands on its way to the next keyframe, so the joint-space path stays the one the safety check passed.
 """
 
 from __future__ import annotations
@@ -47,6 +52,7 @@ class Trajectory:
     stretch: float = 1.0
     anchor_ticks: tuple[int, ...] = ()  # sample index at which each keyframe is reached (0: the start pose)
     late_s: float = 0.0  # timed builds: how much later than asked the last keyframe is reached
+    anchors: np.ndarray | None = None  # the poses the anchor ticks reach (anchors[0]: the start pose)
 
     @property
     def duration(self) -> float:
@@ -112,7 +118,7 @@ class TrajectoryBuilder:
         samples[0] = q_last
         total = duration * stretch
         ticks = tuple(self.tick(total * i / len(rest)) for i in range(len(rest) + 1))
-        return Trajectory(samples, self.dt, stretch, ticks)
+        return Trajectory(samples, self.dt, stretch, ticks, anchors=anchors)
 
     def tick(self, t: float) -> int:
         """The first sample index at or after time t."""
@@ -149,7 +155,20 @@ class TrajectoryBuilder:
         samples = self.limits.project(samples)
         samples[0] = q_last
         ticks = (0, *(self.tick(e) for e in ends))
-        return Trajectory(samples, self.dt, 1.0, ticks, float(ends[-1] - wanted[-1]))
+        return Trajectory(samples, self.dt, 1.0, ticks, float(ends[-1] - wanted[-1]), anchors)
+
+    def catch_up(self, motion: Trajectory, index: int, resume: int) -> Trajectory:
+        """The rest of `motion` after a stall: the arm stands at samples[index] and the returned motion's
+        samples[0] is that pose at old tick `resume` (> index). The keyframes not yet reached keep their old
+        ticks where the speed bound allows, else come as early as it allows; the anchor numbering is kept
+        (reached keyframes get tick 0), so arrival_tick takes the same keyframe indices."""
+        ahead = next(k for k, tick in enumerate(motion.anchor_ticks) if tick > index)
+        here = motion.samples[index]
+        wanted = (np.asarray(motion.anchor_ticks[ahead:]) - resume) * self.dt
+        rest = self.build_timed(np.vstack([here, motion.anchors[ahead:]]), wanted, here)
+        ticks = (0,) * ahead + rest.anchor_ticks[1:]
+        return Trajectory(rest.samples, self.dt, motion.stretch, ticks, motion.late_s + rest.late_s,
+                          motion.anchors)
 
     def _weights(self, segments: int, duration: float) -> np.ndarray:
         """(N + 1, segments + 1) matrix taking the anchors to the 50 Hz samples, cached per (segments, d)."""

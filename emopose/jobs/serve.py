@@ -1,10 +1,12 @@
 """+experiment=serve: the web UI on a live robot (chat, simulation view, Pose Studio).
 
-The control loop runs on its own thread in real time for as long as the server runs; turns are
-planned on a worker thread. uvicorn owns the main thread until Ctrl-C or SIGTERM (it shuts down
-gracefully on both; see emopose/stop_signals.py), then everything is released (the session's close()
-stops the loop and the backend) and the results are written. Settings are validated when the job is built, so
-a bad serve.* value (say, a network bind without a token) stops before anything starts.
+The control loop runs on its own thread in real time for as long as the server runs, at the raised
+priority run.rt_priority asks for (see ControlLoop.start); turns are planned on a worker thread.
+uvicorn owns the main thread until Ctrl-C or SIGTERM (it shuts down gracefully on both; see
+emopose/stop_signals.py), then everything is released (the session's close() stops the loop and the
+backend) and the results are written, the loop's missed deadlines, stalls and lateness among them.
+Settings are validated when the job is built, so a bad serve.* value (say, a network bind without a
+token) stops before anything starts.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ log = logging.getLogger(__name__)
 class ServeJob:
     serve: dict = field(default_factory=dict)
     render: bool = True  # false: no MuJoCo frames anywhere (stick figure only)
+    rt_priority: int = 0  # run.rt_priority: SCHED_FIFO priority of the control loop's thread; 0 leaves it
 
     def __post_init__(self) -> None:
         self.settings = ServeSettings.from_config(self.serve)
@@ -42,7 +45,7 @@ class ServeJob:
         session = open_session(run, self.settings, render=self.render)
         loop = run.session.open()
         try:
-            loop.start()
+            loop.start(self.rt_priority)
             app = create_app(session)
             s = self.settings
             print(f"EmoPose UI: http://{s.host}:{s.port}/  (Pose Studio: /studio)"

@@ -2,13 +2,17 @@
 
 synthesize(reply) renders the reply once, writes <audio_dir>/<key>.wav, takes T_a from the sample
 count, and maps every espeakEVENT_WORD back to character offsets of the reply (word_events.py), so
-SpeechClip.onset_at_char(pos) is the engine's onset of the word at `pos`. Renders are cached on disk
-(<key>.wav + <key>.json with the raw events) and in memory: espeak is deterministic for a given
-voice, rate, pitch and text, and the schedule and the sync evaluation ask for the same reply twice.
+SpeechClip.onset_at_char(pos) is the engine's onset of the word at `pos`. The audio and the word events
+come from one render, and every render starts from the library's freshly initialised state
+(espeak_lib), so a text's render does not depend on what was rendered before. Renders are cached on
+disk (<key>.wav + <key>.json with the raw events and the hash of the samples they were taken from) and in
+memory; the key holds the library version, voice, rate, pitch and text, and a cached entry whose WAV
+is not the audio its events came from is rendered again, so a cached clip's timings are its own.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import logging
 import threading
@@ -18,7 +22,7 @@ from pathlib import Path
 from emopose.speech import espeak_lib
 from emopose.speech.clip import SpeechClip
 from emopose.speech.espeak_lib import WordEvent
-from emopose.speech.wav import cache_dir, clip_key, write_wav
+from emopose.speech.wav import cache_dir, clip_key, read_pcm, write_wav
 from emopose.speech.word_events import words_from_events
 
 log = logging.getLogger(__name__)
@@ -43,15 +47,15 @@ class EspeakSynthesizer:
         self.library_path = library_path
         self.write_audio = write_audio
         self.audio_dir = cache_dir(audio_dir, "tts.audio_dir")
-        self.sample_rate = espeak_lib.engine_sample_rate(library_path)  # fail at build time, with the hint
-        espeak_lib.check_voice(voice, library_path)
+        # fail at build time, with the hint; a new library version renders differently: new cache keys
+        self.sample_rate, self.engine_version = espeak_lib.engine_identity(voice, library_path)
         self._memory: OrderedDict[str, tuple[float, tuple[WordEvent, ...]]] = OrderedDict()
         self._memory_lock = threading.Lock()
 
     def synthesize(self, text: str) -> SpeechClip:
         if not text.strip():
             return SpeechClip(text=text, duration_s=0.0)
-        key = clip_key("espeak", self.voice, self.rate, self.pitch, text)
+        key = self._key(text)
         duration, events = self._rendered(key, text)
         path = self.audio_dir / f"{key}.wav"
         return SpeechClip(text=text, duration_s=duration, words=words_from_events(text, events, duration),
@@ -61,7 +65,10 @@ class EspeakSynthesizer:
         """The engine's raw word events for text (the ground truth the sync evaluation measures against)."""
         if not text.strip():
             return ()
-        return self._rendered(clip_key("espeak", self.voice, self.rate, self.pitch, text), text)[1]
+        return self._rendered(self._key(text), text)[1]
+
+    def _key(self, text: str) -> str:
+        return clip_key("espeak", self.engine_version, "fresh-state", self.voice, self.rate, self.pitch, text)
 
     # -- rendering and the two caches ----------------------------------------------------------
     def _rendered(self, key: str, text: str) -> tuple[float, tuple[WordEvent, ...]]:
@@ -82,8 +89,11 @@ class EspeakSynthesizer:
             return None
         try:
             raw = json.loads(meta.read_text())
+            if self.write_audio and raw["pcm_sha1"] != _pcm_sha1(read_pcm(wav)):
+                log.warning("speech cache %s does not describe %s; re-rendering", meta, wav)
+                return None
             return float(raw["duration_s"]), tuple(WordEvent(*e) for e in raw["events"])
-        except (OSError, ValueError, KeyError, TypeError) as exc:
+        except (OSError, ValueError, KeyError, TypeError, EOFError) as exc:
             log.warning("ignoring unreadable speech cache %s (%s); re-rendering", meta, exc)
             return None
 
@@ -92,10 +102,15 @@ class EspeakSynthesizer:
         if self.write_audio:
             write_wav(self.audio_dir / f"{key}.wav", rendering.pcm, rendering.sample_rate)
         meta = {"duration_s": rendering.duration_s, "sample_rate": rendering.sample_rate,
+                "pcm_sha1": _pcm_sha1(rendering.pcm),
                 "voice": self.voice, "rate": self.rate, "pitch": self.pitch,
                 "events": [[e.char_index, e.length, e.audio_s] for e in rendering.events]}
         _write_text(self.audio_dir / f"{key}.json", json.dumps(meta))
         return rendering.duration_s, rendering.events
+
+
+def _pcm_sha1(pcm: bytes) -> str:
+    return hashlib.sha1(pcm).hexdigest()
 
 
 def _write_text(path: Path, text: str) -> None:

@@ -1,8 +1,13 @@
 """ctypes binding to libespeak-ng: text -> 16-bit mono PCM plus the engine's own word events.
 
-libespeak-ng keeps process-wide state (one voice, one callback, one set of parameters) and is not
-reentrant, so every render goes through one global lock. AUDIO_OUTPUT_SYNCHRONOUS makes
-espeak_Synth return only when the whole text is rendered; the callback runs on the calling thread and
+libespeak-ng keeps process-wide state and is not reentrant. Worse, a render leaves state behind that
+the next one inherits (seen: the sample count drifts, a clause pause grows, a stray word event comes
+before the text): inside one process the same text gave different audio, and onsets up to 128 ms apart,
+depending on what was rendered before; espeak_Terminate + espeak_Initialize does not clear it. So the
+library lives in a small renderer process per voice that initialises it and sets the voice once and
+never renders itself: each request is rendered by a fork of that pristine state, which then exits.
+Every render of a text is thus the one a fresh process would make (same samples, same word events).
+AUDIO_OUTPUT_SYNCHRONOUS makes espeak_Synth return only when the whole text is rendered; the callback
 receives the samples plus espeakEVENT_WORD events (audio_position in ms, text_position, length).
 
 Verified on espeak-ng 1.51: text_position is 1-based and counts characters (Unicode code points, as
@@ -14,6 +19,10 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import logging
+import os
+import pickle
+import subprocess
+import sys
 import threading
 from dataclasses import dataclass
 
@@ -86,7 +95,7 @@ def _load(library_path: str | None) -> ctypes.CDLL:
 
 
 class _Engine:
-    """The one initialised libespeak-ng of this process. Use only under _LOCK."""
+    """The initialised libespeak-ng of the renderer process (serve_renders); never used by its callers."""
 
     def __init__(self, library_path: str | None) -> None:
         lib = self.lib = _load(library_path)
@@ -95,9 +104,11 @@ class _Engine:
         lib.espeak_SetParameter.argtypes = [ctypes.c_int, ctypes.c_int, ctypes.c_int]
         lib.espeak_Synth.argtypes = [ctypes.c_char_p, ctypes.c_size_t, ctypes.c_uint, ctypes.c_int,
                                      ctypes.c_uint, ctypes.c_uint, ctypes.c_void_p, ctypes.c_void_p]
+        lib.espeak_Info.argtypes, lib.espeak_Info.restype = [ctypes.c_void_p], ctypes.c_char_p
         self.sample_rate = lib.espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 0, None, INITIALIZE_DONT_EXIT)
         if self.sample_rate <= 0:
             raise EspeakUnavailable(f"espeak_Initialize failed (espeak-ng-data missing?): {INSTALL_HINT}")
+        self.version = lib.espeak_Info(None).decode(errors="replace")
         self._callback = _Callback(self._on_audio)  # keep a reference: the library only holds the pointer
         lib.espeak_SetSynthCallback(self._callback)
         self._pcm = bytearray()
@@ -139,32 +150,92 @@ class _Engine:
         return Rendering(bytes(self._pcm), self.sample_rate, tuple(self._events))
 
 
+def serve_renders(library_path: str | None, voice: str) -> None:
+    """The renderer process: initialise and set the voice once, then answer each request from a fork.
+    Requests and answers are pickles on stdin / the original stdout (fd 1 then goes to stderr, so
+    nothing the library prints can corrupt an answer)."""
+    answers = os.fdopen(os.dup(1), "wb")
+    os.dup2(2, 1)
+    requests = sys.stdin.buffer
+    try:
+        engine = _Engine(library_path)
+        engine.set_voice(voice)
+    except (EspeakUnavailable, ValueError) as exc:
+        return _answer(answers, exc)
+    _answer(answers, (engine.sample_rate, engine.version))
+    while True:
+        try:
+            text, rate, pitch = pickle.load(requests)
+        except EOFError:
+            return
+        child = os.fork()
+        if child == 0:
+            try:
+                _answer(answers, engine.render(text, voice, rate, pitch))
+            except Exception as exc:  # noqa: BLE001 - handed to the caller, who raises it
+                _answer(answers, exc)
+            os._exit(0)
+        _, status = os.waitpid(child, 0)
+        if status != 0:
+            _answer(answers, RuntimeError(f"espeak render process died (wait status {status})"))
+
+
+def _answer(stream, value: object) -> None:
+    stream.write(pickle.dumps(value))
+    stream.flush()
+
+
+class _Renderer:
+    """The parent's handle on one voice's renderer process. Use only under _LOCK."""
+
+    def __init__(self, library_path: str | None, voice: str) -> None:
+        command = ("from emopose.speech.espeak_lib import serve_renders; "
+                   f"serve_renders({library_path!r}, {voice!r})")
+        self.process = subprocess.Popen([sys.executable, "-c", command], stdin=subprocess.PIPE,
+                                        stdout=subprocess.PIPE)
+        self.sample_rate, self.version = self._receive()
+
+    def render(self, text: str, rate: int, pitch: int) -> Rendering:
+        try:
+            pickle.dump((text, rate, pitch), self.process.stdin)
+            self.process.stdin.flush()
+        except OSError as exc:
+            raise EspeakUnavailable(f"the espeak renderer process exited ({self.process.poll()})") from exc
+        return self._receive()
+
+    def _receive(self):
+        try:
+            answer = pickle.load(self.process.stdout)
+        except EOFError as exc:
+            raise EspeakUnavailable(f"the espeak renderer process exited ({self.process.poll()})") from exc
+        if isinstance(answer, Exception):
+            raise answer
+        return answer
+
+
 _LOCK = threading.Lock()
-_engine: _Engine | None = None
+_renderers: dict[str, _Renderer] = {}
 
 
-def engine_sample_rate(library_path: str | None = None) -> int:
-    """Load and initialise the library once (raises EspeakUnavailable with the install hint)."""
+def engine_identity(voice: str, library_path: str | None = None) -> tuple[int, str]:
+    """(sample rate, library version) of voice's renderer, started once (raises EspeakUnavailable with
+    the install hint, or ValueError for a voice espeak-ng does not have)."""
     with _LOCK:
-        return _get_engine(library_path).sample_rate
-
-
-def check_voice(voice: str, library_path: str | None = None) -> None:
-    with _LOCK:
-        _get_engine(library_path).set_voice(voice)
+        renderer = _get_renderer(voice, library_path)
+        return renderer.sample_rate, renderer.version
 
 
 def render(text: str, voice: str = "en-us", rate: int = 165, pitch: int = 50,
            library_path: str | None = None) -> Rendering:
-    """Synthesize text; thread-safe (one global lock, since libespeak-ng is not reentrant)."""
+    """Synthesize text from the library's freshly initialised state; thread-safe (one request at a time)."""
     with _LOCK:
-        return _get_engine(library_path).render(text, voice, rate, pitch)
+        return _get_renderer(voice, library_path).render(text, rate, pitch)
 
 
-def _get_engine(library_path: str | None) -> _Engine:
-    global _engine
-    if _engine is None:
-        _engine = _Engine(library_path)
+def _get_renderer(voice: str, library_path: str | None) -> _Renderer:
+    renderer = _renderers.get(voice)
+    if renderer is None or renderer.process.poll() is not None:
+        renderer = _renderers[voice] = _Renderer(library_path, voice)
     elif library_path:
-        log.debug("libespeak-ng already loaded; ignoring library_path=%s", library_path)
-    return _engine
+        log.debug("espeak renderer for %s already running; ignoring library_path=%s", voice, library_path)
+    return renderer

@@ -41,6 +41,12 @@ def write_wav(path: Path, pcm: bytes, sample_rate: int) -> Path:
     return path
 
 
+def read_pcm(path: Path) -> bytes:
+    """The samples of a WAV file, as written by write_wav."""
+    with wave.open(str(path), "rb") as audio:
+        return audio.readframes(audio.getnframes())
+
+
 def wav_duration(source: Path | bytes) -> float:
     """Duration in seconds of a WAV file or WAV bytes (raises wave.Error / EOFError if not a WAV)."""
     with wave.open(io.BytesIO(source) if isinstance(source, bytes) else str(source), "rb") as audio:

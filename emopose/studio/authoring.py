@@ -6,10 +6,16 @@ sequencer's own safety hook; so what Pose Studio shows is what the sequencer wou
 Every intensity level is checked, and a motion that self-collides at any of them cannot be saved: the
 planner may ask for any level, and the sequencer would reject the gesture at run time (blocking the save
 is simpler and more honest than storing a per-intensity ceiling that every caller must respect).
+Where the arm stands when the motion starts matters too. Rest (a session's start on the simulator, every
+gesture after a retraction) blocks the save like the levels; each distinct end pose of a library motion
+(itself included) at any level, where the arm holds after a gesture not followed by rest, is checked and
+reported as a warning. Not checked (said in `DraftReport.checked`): co-articulated starts, whose blends
+the timeline checks and replaces by a retraction when unsafe, and a real robot's pose at connect.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -41,6 +47,15 @@ class LevelCheck:
 
 
 @dataclass(frozen=True)
+class StartCheck:
+    """The draft at every level from one pose the arm can be in when it starts."""
+
+    start: str  # "rest (neutral_rest)", "the end pose of neutral_ready at intensity 3"...
+    failed_levels: list[int]
+    reason: str | None  # the first failure's
+
+
+@dataclass(frozen=True)
 class DraftReport:
     intensity: int
     duration: float
@@ -51,7 +66,16 @@ class DraftReport:
     # joints outside the library's limits (+ margin): the library refuses these
     keyframe_violations: list[str]
     trajectory_violations: list[str]
-    levels: list[LevelCheck]
+    levels: list[LevelCheck]  # from rest
+    starts: list[StartCheck]  # from the other poses the arm can start in (rest excluded)
+    check_s: float  # what checking every start pose at every level took
+
+    @property
+    def checked(self) -> str:
+        """Plainly, which starts the self-collision check covered (and which it did not)."""
+        return (f"intensities {LEVELS[0]}-{LEVELS[-1]} from rest and from {len(self.starts)} other start "
+                f"pose(s): the end poses of library motions (this one included); not from co-articulated "
+                f"starts (the timeline checks those blends live) nor a real robot's pose at connect")
 
     @property
     def problems(self) -> list[str]:
@@ -60,6 +84,14 @@ class DraftReport:
         out += [f"self-collision at intensity {c.intensity} (the sequencer would reject it): {c.reason}"
                 for c in self.levels if not c.ok]
         return out
+
+    @property
+    def warnings(self) -> list[str]:
+        """Starts other than rest it collides from: shown, not blocking (shipped motions have such starts;
+        live, the sequencer rejects the gesture there and the reply goes on without it)."""
+        return [f"self-collision at intensity {', '.join(map(str, c.failed_levels))} when it starts from "
+                f"{c.start} (the sequencer would reject it there): {c.reason}"
+                for c in self.starts if c.failed_levels]
 
     def refusal_at(self, intensity: int) -> str | None:
         """Why the draft cannot be performed at this intensity (None: it can)."""
@@ -99,6 +131,7 @@ class PoseStudio:
             raise DraftError(problems) from exc
 
     def report(self, entry: LibraryEntry, intensity: int = NOMINAL_LEVEL) -> DraftReport:
+        started = time.perf_counter()
         start = self.library.neutral_entry.q[0]
         levels, chosen = [], None
         for level in LEVELS:
@@ -107,6 +140,7 @@ class PoseStudio:
             levels.append(self._check(level, trajectory))
             if level == intensity:
                 chosen = (q, trajectory)
+        starts = [self._check_from(entry, label, pose) for label, pose in self.start_poses(entry)[1:]]
         keyframes, trajectory = chosen
         limits = self.library.limits
         rule = entry.model_copy(update={"duration": None}).default_duration  # Eq. duration, shown beside
@@ -114,12 +148,43 @@ class PoseStudio:
             intensity=intensity, duration=entry.default_duration, default_duration=rule,
             explicit_duration=entry.duration is not None, keyframes=keyframes, trajectory=trajectory,
             keyframe_violations=limits.violations(entry.q, self.library.limit_margin),
-            trajectory_violations=limits.violations(trajectory.samples), levels=levels)
+            trajectory_violations=limits.violations(trajectory.samples), levels=levels, starts=starts,
+            check_s=time.perf_counter() - started)
+
+    def start_poses(self, entry: LibraryEntry) -> list[tuple[str, np.ndarray]]:
+        """Rest first, then each distinct end pose of the library's motions (entry's replacing its saved
+        namesake) at every level: where the arm can stand when `entry` starts."""
+        rest = self.library.neutral_entry.q[0]
+        poses = [(f"rest ({self.library.snapshot.neutral})", rest)]
+        others = [e for e in self.library.snapshot.entries.values() if e.name != entry.name]
+        for other in [*others, entry]:
+            for level in LEVELS:
+                end = self.modulate.keyframes(other.q, level)[-1]
+                if not any(np.allclose(end, q, atol=1e-6) for _, q in poses):
+                    name = "itself" if other is entry else other.name
+                    poses.append((f"the end pose of {name} at intensity {level}", end))
+        return poses
+
+    def _check_from(self, entry: LibraryEntry, label: str, start: np.ndarray) -> StartCheck:
+        failed, first = [], None
+        for level in LEVELS:
+            samples = self.builder.build(self.modulate.keyframes(entry.q, level), entry.default_duration,
+                                         start).samples
+            reason = self._refusal(samples)
+            if reason is not None:
+                failed.append(level)
+                first = first or reason
+        return StartCheck(label, failed, first)
 
     def _check(self, level: int, trajectory: Trajectory) -> LevelCheck:
         collision = self.checker.check(trajectory.samples)
-        # The sequencer's hook is the authority (it carries the configured clearance); without one
-        # (safety=off) the default checker still informs the author.
-        reason = self.safety(trajectory.samples) if self.safety is not None else collision.reason
+        reason = self._refusal(trajectory.samples, collision.reason)
         return LevelCheck(level, reason is None, reason, float(collision.min_clearance_m),
                           float(trajectory.stretch))
+
+    def _refusal(self, samples: np.ndarray, checked: str | None = "unchecked") -> str | None:
+        """The sequencer's hook is the authority (it carries the configured clearance); without one
+        (safety=off) the default checker still informs the author (`checked`: its verdict, if known)."""
+        if self.safety is not None:
+            return self.safety(samples)
+        return self.checker.check(samples).reason if checked == "unchecked" else checked

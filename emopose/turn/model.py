@@ -20,7 +20,8 @@ from emopose.speech.clip import SpeechClip
 
 ResolveRule = Literal["exact", "class_default", "neutral", "gated"]
 ReleaseRule = Literal["anchor", "words", "interpolated", "even", "immediate"]
-Fit = Literal["nominal", "scaled", "direct", "coarticulated", "shortened", "late"]
+Fit = Literal["nominal", "scaled", "direct", "coarticulated", "shortened", "softened", "via_halfway",
+              "via_rest", "late"]
 
 
 @dataclass(frozen=True)

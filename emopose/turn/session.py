@@ -72,8 +72,11 @@ class Session:
             self.recorder.write_now(topic, payload)
 
     def record_event(self, event: Event) -> None:
-        """The sequencer's on_event callback: each event on /sequencer/events, on the stream's time base."""
-        self.write(EVENTS, event_message(event, self.loop.stream_time_of(event.t)))
+        """The sequencer's on_event callback: each event on /sequencer/events, on the stream's time base.
+        Payload and log time are both the event's own time (one clock read), so they never disagree."""
+        if self.recording:
+            t = self.loop.stream_time_of(event.t)
+            self.recorder.write(EVENTS, t, event_message(event, t))
 
     def run_time(self, clock_time: float) -> float:
         """Seconds since the run started (open()) of a time read from the loop's clock."""

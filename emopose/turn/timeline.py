@@ -13,9 +13,13 @@ backwards from there. Gestures are placed in the order of their words, each agai
    a blend the robot's safety check would refuse (the arms would collide) is not used;
 4. retracted fast: the previous gesture returns to rest at up to `scale[0]` and this one prepares
    from rest, time-scaled down to `scale[0]`;
-5. dropped, with the reason, when none of these fits.
+5. via a pose, only where 2-3 fit in time but every blend was unsafe: the previous stroke (cut as in 3)
+   blends to a via pose, halfway to rest ("via_halfway") or rest itself ("via_rest"), and on into this
+   preparation, the whole path passing the same safety check;
+6. dropped, with the reason, when none of these fits.
 The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
-preparation needs more, it is compressed (down to `scale[0]`), then shortened to one segment straight
+preparation needs more, it is compressed (down to `first_scale`, below `scale[0]` since only
+the speed bound limits it), then shortened to one segment straight
 to the stroke start ("direct", for strokes after several preparation keyframes), and then lands late.
 Its first segment starts from wherever the arm is at its start time; when the arm is away from rest at
 planning time (a reply interrupting motion, or the thinking gesture, which then blend back to rest), that
@@ -43,6 +47,7 @@ class TimelineSettings:
     lead_s: float = -0.05
     scale: tuple[float, float] = (0.6, 1.3)
     max_preroll_s: float = 0.4
+    first_scale: float = 0.4  # the most a reply's first preparation is compressed (<= scale[0])
     tolerance: float = STROKE_TOLERANCE
     lag_s: float = 0.0
 
@@ -50,6 +55,8 @@ class TimelineSettings:
         low, high = self.scale
         if not 0 < low <= 1.0 <= high:
             raise ValueError(f"timeline scale bounds must satisfy 0 < low <= 1 <= high, got {self.scale}")
+        if not 0 < self.first_scale <= low:
+            raise ValueError(f"timeline first_scale must be in (0, scale[0]], got {self.first_scale}")
         if self.max_preroll_s < 0 or self.tolerance <= 0:
             raise ValueError("timeline max_preroll_s must be >= 0 and tolerance > 0")
 
@@ -115,7 +122,8 @@ class TimelinePlanner:
             # blend from `arm` back to rest stays between the two, so both bounds cover it
             origins = anchors[:1] if arm is None else np.vstack([anchors[0], arm])
             earliest = -self.settings.max_preroll_s
-            placed = self._prepare(name, anchors, stroke, step, origins, False, earliest, aim, (1.0, low))
+            placed = self._prepare(name, anchors, stroke, step, origins, False, earliest, aim,
+                                   (1.0, self.settings.first_scale))
             return placed or self._late(name, anchors, stroke, step, origins, earliest, aim)
         placed = self._prepare(name, anchors, stroke, step, anchors[0], False, prev.times[-1], aim,
                                (1.0, 1.0))
@@ -138,10 +146,27 @@ class TimelinePlanner:
         if placed is not None:
             prev.times[prev.stroke[1]:] = retraction
             return placed
+        via = self._via(name, anchors, stroke, step, prev, aim) if unsafe else None
+        if via is not None:
+            return via
         room = aim - prev.times[prev.stroke[0]]
-        why = f"blending from {prev.name} is unsafe ({unsafe})" if unsafe else (
+        why = f"blending from {prev.name} is unsafe ({unsafe}) and no safe via pose fits" if unsafe else (
             f"too little to prepare at {low:g}x and the joint speed bound")
         return f"no room: its stroke is {room * 1e3:.0f} ms after {prev.name}'s stroke start; {why}"
+
+    def _via(self, name, anchors, stroke, step, prev: _Placed, aim: float) -> _Placed | None:
+        """Rule 5: the first safe path from prev's stroke (latest cut first) through a via pose."""
+        low, high = self.settings.scale
+        for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
+            start_pose = prev.anchors[cut]
+            for via, fit in (((start_pose + anchors[0]) / 2, "via_halfway"), (anchors[0], "via_rest")):
+                shape = np.vstack([anchors[:1], via, anchors[1:]])
+                placed = self._prepare(name, shape, (stroke[0] + 1, stroke[1] + 1), step, start_pose, True,
+                                       prev.times[cut], aim, (high, low), lead=2)
+                if placed is not None and not self._unsafe(placed, start_pose):
+                    prev.cut, placed.fit = cut, fit
+                    return placed
+        return None
 
     def _unsafe(self, placed: _Placed, start_pose: np.ndarray) -> str:
         """Why the co-articulated preparation would fail the robot's safety check ("" if it passes)."""
@@ -168,14 +193,14 @@ class TimelinePlanner:
         return q, gesture.resolved.entry.stroke_span, gesture.duration / (len(q) - 1)
 
     def _prepare(self, name, anchors, stroke, step, start_pose, blend_in, earliest, aim,
-                 scales) -> _Placed | None:
+                 scales, lead: int = 1) -> _Placed | None:
         """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
         to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
-        start; None if even that would need to start before `earliest`."""
+        start from the first `lead` anchors; None if even that would need to start before `earliest`."""
         shapes = [(anchors, stroke, None)]
-        if stroke[0] >= 2:  # skip the intermediate preparation keyframes
-            shapes.append((np.vstack([anchors[:1], anchors[stroke[0]:]]), (1, stroke[1] - stroke[0] + 1),
-                           "direct"))
+        if stroke[0] > lead:  # skip the intermediate preparation keyframes
+            shapes.append((np.vstack([anchors[:lead], anchors[stroke[0]:]]),
+                           (lead, stroke[1] - stroke[0] + lead), "direct"))
         grid = np.arange(scales[0], scales[1] - 1e-9, -0.05).tolist() + [scales[1]]
         for shape, sync, how in shapes:
             for scale in np.unique(np.clip(grid, scales[1], scales[0]))[::-1]:
@@ -191,7 +216,7 @@ class TimelinePlanner:
 
     def _late(self, name, anchors, stroke, step, origins, start, aim) -> _Placed:
         """The first gesture when even the pre-roll and the fastest preparation cannot meet its word."""
-        low = self.settings.scale[0]
+        low = self.settings.first_scale
         durations = self._durations(anchors, origins, 0, stroke[0], step * low, False)
         before = origins if stroke[0] == 1 else anchors[stroke[0] - 1]
         arrival = start + sum(durations) - self._approach(before, anchors[stroke[0]], durations[-1], False)

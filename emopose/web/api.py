@@ -40,7 +40,9 @@ def info(request: Request) -> dict:
 
 @router.get("/status")
 def status(request: Request) -> dict:
-    return session_of(request).status(events_from=max(0, session_of(request).res.sequencer.events.total - 20))
+    """The live state, with the control loop's whole account: missed deadlines, stalls, lateness."""
+    session = session_of(request)
+    return session.status(events_from=max(0, session.res.sequencer.events.total - 20))
 
 
 @router.get("/turns")

@@ -208,8 +208,8 @@ class LiveSession:
             "events": [{"t": e.t, "kind": e.kind, "name": e.name, "detail": e.detail} for e in events],
             "events_next": events_next,
             "loop": None if not session.is_open else {"running": session.loop.running,
-                                                      "ticks": session.loop.stats.ticks,
-                                                      "missed": session.loop.stats.missed_deadlines},
+                                                      "missed": session.loop.stats.missed_deadlines,
+                                                      **session.loop.stats.summary()},
             "library_version": self.res.library.version, "stick": self._stick_now(),
         }
 

@@ -86,7 +86,8 @@ def check(body: DraftRequest, request: Request) -> dict:
         "keyframe_violations": report.keyframe_violations,
         "trajectory_violations": report.trajectory_violations,
         "levels": [vars(c) for c in report.levels], "problems": report.problems,
-        "can_save": not report.problems,
+        "can_save": not report.problems, "starts": [vars(c) for c in report.starts],
+        "warnings": report.warnings, "checked": report.checked, "check_ms": report.check_s * 1e3,
         "stick": stick_frames(trajectory.samples, STICK_EVERY), "stick_dt": trajectory.dt * STICK_EVERY,
     }
 

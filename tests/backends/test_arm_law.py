@@ -79,7 +79,7 @@ def arrival_delay_ticks(law: ArmLaw) -> int:
     """Ticks between the command and the simulated arm coming within the stroke tolerance of a raised
     pose, after a preparation from rest as fast as the speed bound allows (1.5 rad in 0.32 s: a first
     gesture squeezed into the speech pre-roll)."""
-    backend = MujocoBackend(law=law)
+    backend = MujocoBackend(law=law, initial_pose=[0.0] * len(RAISED))  # the arms hanging straight down
     backend.connect(None)
     rest = backend.measured().copy()
     ramp = smoothstep(np.linspace(0.0, 1.0, 17))[:, None]

@@ -122,7 +122,8 @@ def test_model_matches_g1_reference():
     assert m.body("torso_link").mass[0] == pytest.approx(9.598)
 
 
-def test_backend_protocol_and_zero_pose_geometry(backend):
+def test_backend_protocol_and_zero_pose_geometry():
+    backend = MujocoBackend(initial_pose=[0.0] * 14)
     assert isinstance(backend, Backend) and backend.name == "mujoco"
     assert backend.measured() is None
     np.testing.assert_allclose(backend.connect(None), np.zeros(14))

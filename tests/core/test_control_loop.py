@@ -3,12 +3,18 @@ sent as a burst; no two commands closer than half a period; lateness kept in a b
 
 from __future__ import annotations
 
+import logging
+import os
+import sys
+import threading
+
 import numpy as np
 import pytest
 
 from emopose import CONTROL_DT
 from emopose.backends.dry_run import DryRunBackend
 from emopose.clock import FakeClock
+from emopose.execution import control_loop
 from emopose.execution.control_loop import ControlLoop, LoopStats
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.trajectory import TrajectoryBuilder
@@ -131,3 +137,54 @@ def test_the_loop_records_what_the_backend_sent_not_what_was_asked(library, rest
     commands = read_recording(tmp_path / "run.mcap")["/joints/command"]
     assert len(commands) == 1 and np.allclose(commands[0][1]["q"], returned)
     assert not np.allclose(commands[0][1]["q"], rest)  # the requested pose was not what went out
+
+
+# -- the loop thread's priority: what the OS permits, and a clean fallback -----------------------------
+def refuse(*_args) -> None:
+    raise PermissionError("Operation not permitted")
+
+
+def test_the_loop_thread_asks_for_sched_fifo_first(monkeypatch):
+    calls = []
+    monkeypatch.setattr(control_loop.os, "sched_setscheduler", lambda *args: calls.append(args))
+    assert control_loop.raise_thread_priority(10) == "SCHED_FIFO 10"
+    (thread, policy, param), = calls
+    assert thread == threading.get_native_id() and policy == os.SCHED_FIFO and param.sched_priority == 10
+
+
+def test_without_sched_fifo_the_thread_is_reniced_and_without_that_left_alone(monkeypatch, caplog):
+    reniced = []
+    monkeypatch.setattr(control_loop.os, "sched_setscheduler", refuse)
+    monkeypatch.setattr(control_loop.os, "setpriority", lambda *args: reniced.append(args))
+    assert control_loop.raise_thread_priority(10) == f"nice {control_loop.FALLBACK_NICE}"
+    assert reniced == [(os.PRIO_PROCESS, threading.get_native_id(), control_loop.FALLBACK_NICE)]
+    monkeypatch.setattr(control_loop.os, "setpriority", refuse)
+    with caplog.at_level(logging.WARNING, logger=control_loop.__name__):
+        assert control_loop.raise_thread_priority(10) == "normal"
+    assert len(caplog.records) == 1 and "not permitted" in caplog.records[0].getMessage()
+
+
+@pytest.mark.parametrize("priority, expected", [(10, "SCHED_FIFO 10"), (0, "normal")])
+def test_start_raises_the_thread_and_shortens_the_switch_interval_until_stop(make_loop, monkeypatch,
+                                                                             priority, expected):
+    """On the loop's own thread, only when asked; stop() gives the process its switch interval back."""
+    asked_from = []
+    monkeypatch.setattr(control_loop, "raise_thread_priority",
+                        lambda p: asked_from.append(threading.current_thread().name) or f"SCHED_FIFO {p}")
+    loop, _, _ = make_loop()
+    before = sys.getswitchinterval()
+    loop.start(priority)
+    try:
+        assert sys.getswitchinterval() == (control_loop.RT_SWITCH_INTERVAL_S if priority else before)
+    finally:
+        loop.stop()
+    assert sys.getswitchinterval() == before
+    assert asked_from == (["emopose-control"] if priority else [])
+    assert loop.stats.scheduling == loop.stats.summary()["scheduling"] == expected
+
+
+def test_the_summary_reports_misses_per_tick():
+    stats = LoopStats(ticks=400, missed_deadlines=6, stalls=2)
+    summary = stats.summary()
+    assert summary["missed_per_tick"] == pytest.approx(0.015)
+    assert summary["missed_deadlines"] == 6 and summary["stalls"] == 2

@@ -39,7 +39,7 @@ def test_a_trigger_on_the_first_word_delays_the_speech_by_a_bounded_preroll(g1):
     point = gesture(g1, "point_forward_right")
     (timing,), preroll = planner(g1).plan([point], [0.0])
     assert 0 < preroll <= 0.4 and timing.times[0] == pytest.approx(-preroll)
-    assert timing.fit in ("scaled", "late") and 0.6 <= timing.scale < 1.0
+    assert timing.fit in ("scaled", "late") and 0.4 <= timing.scale < 1.0
     (capped,), preroll = planner(g1, max_preroll_s=0.1).plan([point], [0.0])
     assert preroll == pytest.approx(0.1) and capped.fit == "late" and capped.arrival_s > capped.target_s
 
@@ -99,7 +99,8 @@ def test_every_segment_respects_the_speed_bound_and_the_scale_bounds(g1):
         placed = sorted((t for t in timings if not isinstance(t, str)), key=lambda t: t.times[0])
         for previous, timing in zip([None, *placed], placed):
             assert previous is None or timing.times[0] >= previous.times[-1] - 1e-9
-            assert 0.6 - 1e-9 <= timing.scale <= 1.3 + 1e-9
+            low = 0.4 if previous is None else 0.6  # a reply's first preparation: down to first_scale
+            assert low - 1e-9 <= timing.scale <= 1.3 + 1e-9
             poses = np.array(timing.keyframes)
             if timing.blend_in:
                 poses[0] = previous.keyframes[-1]  # it starts from where the previous one was cut
@@ -116,8 +117,29 @@ def test_an_unsafe_coarticulation_blend_falls_back_to_rest_or_a_drop(g1):
     assert isinstance(b, str) and "unsafe (arms collide)" in b or not b.blend_in
 
 
+def test_an_unsafe_direct_blend_is_kept_through_a_safe_via_pose(g1):
+    first, second = gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")
+    rest = first.keyframes[0]
+    # a safety check that passes only paths through the rest pose: the direct blends and the halfway via fail
+    through_rest = lambda samples: (  # noqa: E731
+        None if np.min(np.max(np.abs(samples - rest), axis=1)) < 1e-3 else "arms collide")
+    (a, b), _ = planner(g1, safety=through_rest).plan([first, second], [1.0, 2.2])
+    assert b.fit == "via_rest" and b.blend_in and a.cut
+    assert np.allclose(b.keyframes[1], rest)  # the via pose, before the preparation
+    assert b.stroke == tuple(i + 1 for i in second.resolved.entry.stroke_span)
+    assert arrival(g1, b, a.keyframes[-1]) == pytest.approx(2.2 - 0.05, abs=0.021)
+    builder = TrajectoryBuilder(g1.limits)
+    poses = [a.keyframes[-1], *b.keyframes[1:]]
+    for i in range(1, len(b.times)):
+        assert b.times[i] - b.times[i - 1] >= builder.segment_minimum(poses[i - 1], poses[i], i == 1) - 1e-9
+    (_, dropped), _ = planner(g1, safety=lambda samples: "arms collide").plan([first, second], [1.0, 2.2])
+    assert "unsafe (arms collide) and no safe via pose fits" in dropped
+
+
 def test_settings_are_validated():
     with pytest.raises(ValueError, match="scale"):
         TimelineSettings(scale=(1.2, 1.3))
     with pytest.raises(ValueError, match="preroll"):
         TimelineSettings(max_preroll_s=-1)
+    with pytest.raises(ValueError, match="first_scale"):
+        TimelineSettings(first_scale=0.7)

@@ -103,11 +103,7 @@ def test_concurrent_synthesis_is_serialised_and_correct(tmp_path):
         t.join()
     assert not errors and set(results) == set(expected)
     for text, events in results.items():
-        # espeak carries a little state from the previous text: onsets may move by ~10 ms between renders,
-        # and now and then it reports a word before the text (char -1), which clean_events drops
-        got, want = clean_events(text, events), clean_events(text, expected[text])
-        assert list(got) == list(want) and len(got) == 7
-        assert all(abs(got[i] - want[i]) <= 0.02 for i in want)
+        assert events == expected[text] and len(clean_events(text, events)) == 7  # every render is fresh
 
 
 def test_voice_rate_pitch_are_applied_and_validated(tmp_path):

@@ -52,7 +52,7 @@ def test_controller_at_the_goal_only_turns_and_refuses_fast_settings():
 
 
 def sim_navigator(velocity_std=0.0, yaw_rate_std=0.0, seed=0):
-    backend = MujocoBackend(planar_base=MujocoPlanarBase())
+    backend = MujocoBackend(planar_base=MujocoPlanarBase(), initial_pose=[0.0] * 14)  # arms held down
     q0 = backend.connect(None)
     base = MujocoBase(backend.planar_base, velocity_std, yaw_rate_std, seed)
     clock = [0.0]
@@ -78,7 +78,7 @@ def test_mujoco_base_reaches_the_four_lab_stops():
 
 
 def test_walking_is_a_command_in_force_not_the_sway_of_gesturing_arms():
-    backend = MujocoBackend(planar_base=MujocoPlanarBase())
+    backend = MujocoBackend(planar_base=MujocoPlanarBase(), initial_pose=[0.0] * 14)
     q0 = backend.connect(None)
     base = MujocoBase(backend.planar_base)
 

@@ -51,6 +51,17 @@ def test_info_and_a_typed_turn_with_timed_cues(client):
     assert wait_for(lambda: client.get("/api/status").json()["state"] != "idle")
 
 
+def test_status_gives_the_loops_missed_deadlines_stalls_and_lateness(client):
+    stats = client.app.state.session.run.session.loop.stats
+    assert wait_for(lambda: client.get("/api/status").json()["loop"]["ticks"] > 0)
+    stats.missed_deadlines += 7  # as a stall would count them
+    stats.stalls += 2
+    loop = client.get("/api/status").json()["loop"]
+    assert loop["running"] and loop["missed"] == loop["missed_deadlines"] >= 7 and loop["stalls"] >= 2
+    assert loop["missed_per_tick"] == pytest.approx(loop["missed_deadlines"] / loop["ticks"], rel=0.2)
+    assert loop["lateness_ms_max"] >= loop["lateness_ms_p99"] >= 0 and loop["scheduling"] == "normal"
+
+
 def test_each_cue_learns_where_its_stroke_actually_landed(client):
     turn = client.post("/api/say", json={"text": "Welcome! The robot arm is over there."}).json()
 

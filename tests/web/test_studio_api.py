@@ -28,6 +28,18 @@ def test_studio_check_builds_the_50hz_trajectory_with_the_duration_rule(client):
     assert len(report["stick"]) >= 10 and set(report["stick"][0]) == {"front", "side"}
 
 
+def test_studio_checks_the_start_poses_a_motion_can_meet(client):
+    """hands_on_heart passes from rest but collides at intensity 4 after neutral_ready's held end pose:
+    the check says so (a warning, with what it checked) instead of passing it silently."""
+    heart = client.get("/api/library/hands_on_heart").json()
+    report = client.post("/api/studio/check", json={"keyframes": heart["keyframes"]}).json()
+    assert report["can_save"] and all(c["ok"] for c in report["levels"])  # from rest
+    ready = [c for c in report["starts"] if "neutral_ready" in c["start"]]
+    assert ready and ready[0]["failed_levels"] == [4] and "clearance" in ready[0]["reason"]
+    assert any("neutral_ready" in w and "intensity 4" in w for w in report["warnings"])
+    assert report["checked"].startswith("intensities 1-5 from rest and from ") and report["check_ms"] > 0
+
+
 def test_studio_shows_checks_and_saves_the_stroke(client, library_copy):
     rest = client.get("/api/library").json()["neutral_pose"]
     up, further = list(rest), list(rest)

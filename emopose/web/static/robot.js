@@ -43,6 +43,11 @@ export class RobotPanel {
     queue.replaceChildren(...(state.pending.length ? state.pending.map((c) => el("li", {},
       el("span", { text: c.name }), el("span", { class: "muted small", text: c.release_in_s > 0 ? `in ${c.release_in_s.toFixed(1)} s` : "released" })))
       : [el("li", { class: "muted", text: "empty" })]));
+    if (state.loop) {  // deadlines the 50 Hz loop missed: a stalled loop delays every gesture after it
+      const share = state.loop.ticks ? (100 * state.loop.missed) / state.loop.ticks : 0;
+      $("loop-missed").textContent = `${state.loop.missed} missed of ${state.loop.ticks} ticks (${share.toFixed(2)} %)`;
+      $("loop-missed").className = share > 1 ? "late" : "";
+    }
     const events = $("events");
     for (const e of state.events) {
       if (e.kind === "state") continue;

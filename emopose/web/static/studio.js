@@ -149,7 +149,9 @@ function renderChecks(r) {
     title: c.reason || "", text: `i${c.intensity} ${c.ok ? "✓" : "✗"} ${(c.min_clearance_m * 100).toFixed(1)} cm` })));
   $("check-speed").replaceChildren(r.stretch > 1.001
     ? el("span", { class: "pill warn", text: `slowed ×${r.stretch.toFixed(2)} to respect joint speed limits` }) : el("span", { class: "pill ok", text: "within speed limits" }));
-  $("check-notes").replaceChildren(...r.problems.map((p) => el("li", { class: "bad", style: "color:var(--bad)", text: p })));
+  $("check-notes").replaceChildren(...r.problems.map((p) => el("li", { class: "bad", style: "color:var(--bad)", text: p })),
+    ...r.warnings.map((w) => el("li", { class: "warn", text: `warning: ${w}` })),
+    el("li", { class: "muted small", text: `checked: ${r.checked} (${r.check_ms.toFixed(0)} ms)` }));
   $("verdict").replaceChildren(el("span", { class: `pill ${r.can_save ? "ok" : "bad"}`, text: r.can_save ? "ready to save" : "cannot save" }));
   updateSaveButton();
 }
