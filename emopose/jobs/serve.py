@@ -29,6 +29,8 @@ class ServeJob:
     rt_priority: int = 0  # run.rt_priority: SCHED_FIFO priority of the control loop's thread; 0 leaves it
 
     def __post_init__(self) -> None:
+        if not 0 <= self.rt_priority <= 99:  # the OS would refuse it and the loop fall back unnoticed
+            raise ValueError(f"run.rt_priority={self.rt_priority}: a SCHED_FIFO priority is 1-99 (0: normal)")
         self.settings = ServeSettings.from_config(self.serve)
 
     def __call__(self, run: Run) -> JobOutput:

@@ -25,6 +25,7 @@ import subprocess
 import sys
 import threading
 from dataclasses import dataclass
+from pathlib import Path
 
 log = logging.getLogger(__name__)
 
@@ -191,8 +192,12 @@ class _Renderer:
     def __init__(self, library_path: str | None, voice: str) -> None:
         command = ("from emopose.speech.espeak_lib import serve_renders; "
                    f"serve_renders({library_path!r}, {voice!r})")
+        # the child imports this module from the same checkout, installed or not (a benchmark run from it)
+        root = str(Path(__file__).resolve().parents[2])
+        paths = filter(None, (root, os.environ.get("PYTHONPATH")))
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
         self.process = subprocess.Popen([sys.executable, "-c", command], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE)
+                                        stdout=subprocess.PIPE, env=env)
         self.sample_rate, self.version = self._receive()
 
     def render(self, text: str, rate: int, pitch: int) -> Rendering:

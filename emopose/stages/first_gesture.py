@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from emopose.stages.modulate import INTENSITY_GAINS
+from emopose.stages.modulate import INTENSITY_GAINS, scale_excursion
 from emopose.turn.model import GestureTiming, ModulatedGesture
 from emopose.turn.timeline import TimelinePlanner
 
@@ -42,10 +42,7 @@ class FirstWordSettings:
 
 def softened(gesture: ModulatedGesture, intensity: int, gains: tuple[float, ...]) -> ModulatedGesture:
     """`gesture` at a lower `intensity`: interior keyframes pulled toward the start pose."""
-    q = np.array(gesture.keyframes, dtype=float)
-    if len(q) >= 3:
-        ratio = gains[intensity - 1] / gains[gesture.intensity - 1]
-        q[1:-1] = q[0] + ratio * (q[1:-1] - q[0])
+    q = scale_excursion(gesture.keyframes, gains[intensity - 1] / gains[gesture.intensity - 1])
     record = gesture.resolved.record.model_copy(update={"intensity": intensity})
     return replace(gesture, resolved=replace(gesture.resolved, record=record), keyframes=q)
 

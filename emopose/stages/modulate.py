@@ -26,8 +26,16 @@ def modulate_keyframes(q: np.ndarray, intensity: int, limits: JointLimits,
     out = np.array(q, dtype=float)
     if intensity == 3 or len(out) < 3:
         return out
-    interior = out[1:-1]
-    out[1:-1] = limits.project(out[0] + gains[intensity - 1] * (interior - out[0]), margin)
+    out[1:-1] = limits.project(scale_excursion(out, gains[intensity - 1])[1:-1], margin)
+    return out
+
+
+def scale_excursion(q: np.ndarray, gain: float) -> np.ndarray:
+    """Eq. intensity's core: interior keyframes moved `gain` times as far from the first one (first and
+    last unchanged; fewer than three keyframes have no interior)."""
+    out = np.array(q, dtype=float)
+    if len(out) >= 3:
+        out[1:-1] = out[0] + gain * (out[1:-1] - out[0])
     return out
 
 

@@ -13,6 +13,7 @@ import pytest
 
 from emopose import CONTROL_DT
 from emopose.backends.dry_run import DryRunBackend
+from emopose.build import ConfigError, build_job
 from emopose.clock import FakeClock
 from emopose.execution import control_loop
 from emopose.execution.control_loop import ControlLoop, LoopStats
@@ -188,3 +189,9 @@ def test_the_summary_reports_misses_per_tick():
     summary = stats.summary()
     assert summary["missed_per_tick"] == pytest.approx(0.015)
     assert summary["missed_deadlines"] == 6 and summary["stalls"] == 2
+
+
+@pytest.mark.parametrize("priority", [-1, 100, 500])
+def test_an_impossible_loop_priority_is_a_config_error(compose, priority):
+    with pytest.raises(ConfigError, match=r"run.rt_priority=.*1-99"):
+        build_job(compose("+experiment=serve", f"run.rt_priority={priority}"))
