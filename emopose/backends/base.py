@@ -24,6 +24,12 @@ class Backend(ABC):
     # How long the joints trail the commanded stream (s): motors under their control law. The timeline
     # plans strokes this much ahead; a backend without actuators (dry run) has none.
     tracking_lag_s: float = 0.0
+    # True: measured() reads the joints (a simulator's state, the robot's LowState), so the STROKE event
+    # comes from them (execution/stroke_watch.py); False: measured() echoes the command (dry run).
+    measures_joints: ClassVar[bool] = False
+    # How far ahead of the send time the pose measured right after send() stands (a simulator that
+    # stepped one period of physics in send(): CONTROL_DT; a robot's latest state: 0).
+    measured_lead_s: ClassVar[float] = 0.0
 
     @abstractmethod
     def connect(self, recorder: Recorder | None) -> np.ndarray | None:

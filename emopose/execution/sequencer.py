@@ -1,22 +1,13 @@
-"""The robot-side gesture sequencer (paper Fig. sequencer): one active trajectory, a FIFO queue.
-Its states and their transitions: State (gesture_command.py).
-Beyond the paper (off by default): with `preempt_after_s` set, a queued command whose release time has
-passed by that much cuts the running motion short with a normal blend, so long motions do not push
-later gestures away from their words (-blend_s: the successor begins on its word).
-
-`step(now)`, once per 50 Hz tick, returns the 14-DoF target to publish; every transition starts from the
-latest published pose, so the stream never jumps. submit/interrupt are thread-safe. Time is the `now`
-the caller passes (tests drive it with a fake clock).
-
-Timed commands (the stroke-synchronous timeline, emopose/turn/timeline.py) carry every keyframe's time:
-one starts at its release time from the pose published then (no blend in front: its first segment is its
-own transition), preempting (CUT) a motion still running, and its trajectory meets the keyframe
-times, lengthening only what the speed bound forbids. Events: EventKind (gesture_command.py); STROKE
-is the arm within STROKE_TOLERANCE of the stroke-start keyframe.
-
-Motions are sampled on the clock (sample n at start + n * dt). After a stall (skipped ticks) a running
-gesture catches up (TrajectoryBuilder.catch_up), one sample per tick, never a jump; one whose stroke would
-still be over `stall_stop_late_s` late is STOPPED (detail: how late) and the arm recovers toward neutral.
+"""The robot-side gesture sequencer (paper Fig. sequencer): one active trajectory, a FIFO queue; states
+and transitions: State (gesture_command.py). `step(now)` (50 Hz) returns the target to publish; every
+transition starts from the latest published pose (no jumps); submit/interrupt are thread-safe; time is
+the caller's `now`. `preempt_after_s` (off by default): a command overdue by that much cuts the running
+motion short with a blend. Timed commands (turn/timeline.py) fix every keyframe's time: one starts at its
+release from the pose published then, preempting (CUT) a motion still running, lengthening only what the
+speed bound forbids. After a stall a running gesture catches up (TrajectoryBuilder.catch_up) or is
+STOPPED when its stroke would be over `stall_stop_late_s` late. STROKE: the arm within STROKE_TOLERANCE of
+the stroke-start keyframe, as commanded or, where the backend measures its joints (`observe`, the
+StrokeWatch), as measured, the command's arrival then being STROKE_COMMANDED.
 """
 
 from __future__ import annotations
@@ -32,6 +23,7 @@ import numpy as np
 from emopose.contract import EventKind
 from emopose.execution.bounded_log import BoundedLog
 from emopose.execution.gesture_command import Event, GestureCommand, State
+from emopose.execution.stroke_watch import StrokeWatch
 from emopose.execution.trajectory import Trajectory, TrajectoryBuilder
 
 SafetyCheck = Callable[[np.ndarray], "str | None"]
@@ -50,6 +42,7 @@ class Sequencer:
         self.interrupt_blend_s, self.neutral_tolerance = interrupt_blend_s, neutral_tolerance
         self.preempt_after_s, self.stall_stop_late_s = preempt_after_s, stall_stop_late_s
         self.on_event = on_event
+        self.stroke_watch = StrokeWatch()  # measuring once a control loop's backend measures its joints
         self.events: BoundedLog[Event] = BoundedLog(keep_events)
         self.construction_s: BoundedLog[float] = BoundedLog(keep_events)
         self._lock = threading.RLock()
@@ -68,6 +61,7 @@ class Sequencer:
             self._after_blend: GestureCommand | None = None
             self._stroke_tick = -1
             self._hold_since = now
+            self.stroke_watch.clear()
 
     def submit(self, command: GestureCommand) -> None:
         with self._lock:
@@ -80,8 +74,7 @@ class Sequencer:
 
     def interrupt(self, commands: list[GestureCommand] | tuple = (), now: float | None = None) -> None:
         """Clear pending actions; blend from the latest published pose to the first new command (or neutral).
-        A timeline (timed commands) is queued whole: the arm heads for rest until its first gesture's
-        start, which then prepares from wherever the arm is."""
+        A timeline is queued whole: the arm heads for rest until its first gesture prepares from there."""
         with self._lock:
             now = self._hold_since if now is None else now
             if self._active is not None:
@@ -96,8 +89,7 @@ class Sequencer:
                 self._start_blend(now, self.neutral, self.recover_s, None)
 
     def retime(self, ids: set[int], delta: float) -> int:
-        """Move the release of the queued commands in `ids` by delta seconds (their speech started that much
-        later than planned); returns how many moved. Commands already running are not touched."""
+        """Move the queued commands in `ids` delta s later (their speech started late); how many moved."""
         with self._lock:
             moved = [k for k, command in enumerate(self._queue) if command.id in ids]
             for k in moved:
@@ -137,6 +129,12 @@ class Sequencer:
                 self._recover(now)
             return self.last.copy()
 
+    def observe(self, now: float, measured: np.ndarray) -> None:
+        """A measured arm pose at `now`: emits the STROKE events it completes (see StrokeWatch)."""
+        with self._lock:
+            for stroke in self.stroke_watch.observe(now, measured):
+                self._emit(now, EventKind.STROKE, stroke.command, stroke.detail)
+
     # -- internals (lock held) -----------------------------------------------------------------
     def _advance(self, now: float) -> None:
         due = round((now - self._motion_t0) / self.builder.dt)  # the sample this tick stands for
@@ -145,16 +143,13 @@ class Sequencer:
         self._index += 1
         self.last = self._motion.samples[self._index].copy()
         if self._index == self._stroke_tick and self.state == State.EXECUTING:
-            self._emit(now, EventKind.STROKE, self._active)
+            self._stroke_commanded(now)
         if self._index < len(self._motion.samples) - 1:
             return
         if self.state == State.EXECUTING:
-            done = self._active
-            if done.cut:
-                self._emit(now, EventKind.CUT, done, "co-articulated into the next gesture")
-            else:
-                self._emit(now, EventKind.COMPLETED, done)
-            self._active = None
+            done, self._active = self._active, None
+            self._emit(now, *((EventKind.CUT, done, "co-articulated into the next gesture") if done.cut
+                              else (EventKind.COMPLETED, done)))
             head = self._queue[0] if self._queue else None
             if head is not None and head.release_at <= now:
                 self._queue.popleft()
@@ -171,8 +166,7 @@ class Sequencer:
             self._set_state(now, State.IDLE)
 
     def _catch_up(self, now: float, due: int) -> bool:
-        """Re-time the running gesture after a stall (its next sample is this tick's); False when it was
-        stopped instead, because its stroke would come more than stall_stop_late_s late."""
+        """Re-time the running gesture after a stall; False: stopped (stroke > stall_stop_late_s late)."""
         motion, dt = self.builder.catch_up(self._motion, self._index, due - 1), self.builder.dt
         ahead = self._stroke_tick > self._index  # else reported already, or none
         stroke_tick = motion.arrival_tick(self._active.keyframes, self._active.stroke[0]) if ahead else -1
@@ -183,6 +177,12 @@ class Sequencer:
             return False
         self._motion, self._index, self._motion_t0, self._stroke_tick = motion, 0, now - dt, stroke_tick
         return True
+
+    def _stroke_commanded(self, now: float) -> None:
+        if self.stroke_watch.measuring:
+            self.stroke_watch.expect(self._active, now)
+        self._emit(now, EventKind.STROKE_COMMANDED if self.stroke_watch.measuring else EventKind.STROKE,
+                   self._active)
 
     def _timed_head_due(self, now: float) -> bool:
         return bool(self._queue) and self._queue[0].timed and self._queue[0].release_at <= now

@@ -21,11 +21,10 @@ import ctypes.util
 import logging
 import os
 import pickle
-import subprocess
-import sys
 import threading
 from dataclasses import dataclass
-from pathlib import Path
+
+from emopose.child_process import ChildProcess, ChildProcessGone, answer_channel, send_answer
 
 log = logging.getLogger(__name__)
 
@@ -152,18 +151,14 @@ class _Engine:
 
 
 def serve_renders(library_path: str | None, voice: str) -> None:
-    """The renderer process: initialise and set the voice once, then answer each request from a fork.
-    Requests and answers are pickles on stdin / the original stdout (fd 1 then goes to stderr, so
-    nothing the library prints can corrupt an answer)."""
-    answers = os.fdopen(os.dup(1), "wb")
-    os.dup2(2, 1)
-    requests = sys.stdin.buffer
+    """The renderer process: initialise and set the voice once, then answer each request from a fork."""
+    requests, answers = answer_channel()
     try:
         engine = _Engine(library_path)
         engine.set_voice(voice)
     except (EspeakUnavailable, ValueError) as exc:
-        return _answer(answers, exc)
-    _answer(answers, (engine.sample_rate, engine.version))
+        return send_answer(answers, exc)
+    send_answer(answers, (engine.sample_rate, engine.version))
     while True:
         try:
             text, rate, pitch = pickle.load(requests)
@@ -172,50 +167,32 @@ def serve_renders(library_path: str | None, voice: str) -> None:
         child = os.fork()
         if child == 0:
             try:
-                _answer(answers, engine.render(text, voice, rate, pitch))
+                send_answer(answers, engine.render(text, voice, rate, pitch))
             except Exception as exc:  # noqa: BLE001 - handed to the caller, who raises it
-                _answer(answers, exc)
+                send_answer(answers, exc)
             os._exit(0)
         _, status = os.waitpid(child, 0)
         if status != 0:
-            _answer(answers, RuntimeError(f"espeak render process died (wait status {status})"))
-
-
-def _answer(stream, value: object) -> None:
-    stream.write(pickle.dumps(value))
-    stream.flush()
+            send_answer(answers, RuntimeError(f"espeak render process died (wait status {status})"))
 
 
 class _Renderer:
     """The parent's handle on one voice's renderer process. Use only under _LOCK."""
 
     def __init__(self, library_path: str | None, voice: str) -> None:
-        command = ("from emopose.speech.espeak_lib import serve_renders; "
-                   f"serve_renders({library_path!r}, {voice!r})")
-        # the child imports this module from the same checkout, installed or not (a benchmark run from it)
-        root = str(Path(__file__).resolve().parents[2])
-        paths = filter(None, (root, os.environ.get("PYTHONPATH")))
-        env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
-        self.process = subprocess.Popen([sys.executable, "-c", command], stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, env=env)
-        self.sample_rate, self.version = self._receive()
+        self.child = ChildProcess("emopose.speech.espeak_lib", "serve_renders", library_path, voice,
+                                  name="espeak renderer")
+        self.sample_rate, self.version = self._receive(self.child.receive)
 
     def render(self, text: str, rate: int, pitch: int) -> Rendering:
-        try:
-            pickle.dump((text, rate, pitch), self.process.stdin)
-            self.process.stdin.flush()
-        except OSError as exc:
-            raise EspeakUnavailable(f"the espeak renderer process exited ({self.process.poll()})") from exc
-        return self._receive()
+        return self._receive(lambda: self.child.request((text, rate, pitch)))
 
-    def _receive(self):
+    @staticmethod
+    def _receive(answer):
         try:
-            answer = pickle.load(self.process.stdout)
-        except EOFError as exc:
-            raise EspeakUnavailable(f"the espeak renderer process exited ({self.process.poll()})") from exc
-        if isinstance(answer, Exception):
-            raise answer
-        return answer
+            return answer()
+        except ChildProcessGone as exc:
+            raise EspeakUnavailable(str(exc)) from exc
 
 
 _LOCK = threading.Lock()
@@ -239,7 +216,7 @@ def render(text: str, voice: str = "en-us", rate: int = 165, pitch: int = 50,
 
 def _get_renderer(voice: str, library_path: str | None) -> _Renderer:
     renderer = _renderers.get(voice)
-    if renderer is None or renderer.process.poll() is not None:
+    if renderer is None or not renderer.child.alive:
         renderer = _renderers[voice] = _Renderer(library_path, voice)
     elif library_path:
         log.debug("espeak renderer for %s already running; ignoring library_path=%s", voice, library_path)

@@ -16,6 +16,7 @@ from typing import Protocol
 
 from emopose.backends.base import Backend
 from emopose.backends.capabilities import SimulatedState
+from emopose.execution.control_loop import check_rt_priority
 from emopose.library import MotionLibrary
 from emopose.planners.base import Planner
 from emopose.resources import Run
@@ -47,6 +48,10 @@ class TourJob:
     answer_mode: str = "respond"  # planners with a `mode` answer visitors in this mode
     video: bool = True
     base: dict | None = None  # the tour/base node (conf/tour/base/), built by build.make
+    rt_priority: int = 0  # run.rt_priority: the control loop thread's SCHED_FIFO priority in real time
+
+    def __post_init__(self) -> None:
+        check_rt_priority(self.rt_priority)
 
     def load(self) -> TourSpec:
         if self.tour_file:
@@ -63,7 +68,7 @@ class TourJob:
         loop = run.session.open()
         base = tour_base.open(res.backend, spec)
         if res.clock.realtime:
-            loop.start()  # real time: the loop streams on its own thread, the tour waits on it
+            loop.start(self.rt_priority)  # real time: the loop streams on its thread, the tour waits on it
         runner = TourRunner(run, spec, base, camera_for(res.backend),
                             answer_planner=self.answering_planner(res.planner, res.library))
         started = time.perf_counter()

@@ -1,12 +1,13 @@
-"""MuJoCo frames for the web UI, rendered kinematically on one dedicated thread.
+"""MuJoCo frames for the web UI, rendered kinematically in a child process of their own.
 
 Why not the backend's renderer: rendering in the 50 Hz control thread (backend.renderer.live=true) costs
-50-1000 ms a frame under software EGL and would make the loop miss its deadlines. Here one worker
-thread owns its own model, MjData and Renderer (an EGL context is current in one thread only, and
-several contexts created and freed in one process corrupted frames under Mesa), sets the pose to
-show (the simulator's full qpos, or 14 joint angles) and renders through robot/render.py's
-OffscreenRenderer. Quality 'fast' edits this private model copy to drop MSAA, shadows and
-reflections: about 10x cheaper on llvmpipe, so >= 10 fps at 320x240 on a CPU.
+50-1000 ms a frame under software EGL and would make the loop miss its deadlines. Why not a thread:
+rendering and JPEG encoding hold the GIL for about 14 ms a frame, so the loop thread, however high its
+priority, waited behind them (gaps of 80 ms between commands with two pages watching). So one child
+process (emopose.child_process) owns its own model, MjData and Renderer, at a lower CPU priority than
+the server; it sets the pose to show (the simulator's full qpos, or 14 joint angles), renders through
+robot/render.py's OffscreenRenderer and answers JPEG bytes. Quality 'fast' edits this private model
+copy to drop MSAA, shadows and reflections: about 10x cheaper on llvmpipe, so >= 10 fps at 320x240.
 """
 
 from __future__ import annotations
@@ -14,11 +15,15 @@ from __future__ import annotations
 import io
 import logging
 import os
-from concurrent.futures import ThreadPoolExecutor
+import threading
 
 import numpy as np
 
+from emopose.child_process import ChildProcess, ChildProcessGone, serve_requests
+
 log = logging.getLogger(__name__)
+
+RENDER_NICENESS = 5  # frames for the page yield the CPU to planning and speech synthesis
 
 
 class RenderUnavailable(RuntimeError):
@@ -36,26 +41,28 @@ def encode_jpeg(image: np.ndarray, quality: int = 80) -> bytes:
 class PoseRenderer:
     def __init__(self, model_path: str | None = None, planar_base: bool = False, width: int = 320,
                  height: int = 240, quality: str = "fast", jpeg_quality: int = 80) -> None:
-        self.model_path, self.planar_base = model_path, planar_base
-        self.width, self.height, self.quality, self.jpeg_quality = width, height, quality, jpeg_quality
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="emopose-render")
-        self._state: dict | None = None
+        self.settings = (model_path, planar_base, width, height, quality, jpeg_quality)
+        self._child: ChildProcess | None = None
+        self._lock = threading.Lock()  # one request at a time on the pipe
         self.error: str | None = None
 
     def start(self, timeout_s: float = 120.0) -> bool:
-        """Create the renderer on its thread; False (with .error) when rendering is unavailable."""
+        """Start the render process; False (with .error) when rendering is unavailable."""
         try:
-            self._pool.submit(self._init).result(timeout=timeout_s)
+            self._child = ChildProcess("emopose.web.pose_renderer", "serve_frames", *self.settings,
+                                       name="frame renderer")
+            self._child.receive(timeout_s)
             return True
         except Exception as exc:  # noqa: BLE001 -- any failure here means "no MuJoCo frames", not a crash
             self.error = f"{type(exc).__name__}: {exc}"[:300]
+            self.close()
             log.warning("MuJoCo offscreen rendering unavailable (%s); the UI draws a stick figure",
                         self.error)
             return False
 
     @property
     def available(self) -> bool:
-        return self._state is not None
+        return self._child is not None and self._child.alive
 
     def render_jpeg(self, q: np.ndarray | None = None, qpos: np.ndarray | None = None,
                     camera: str = "front", timeout_s: float = 30.0) -> bytes:
@@ -64,24 +71,32 @@ class PoseRenderer:
     def render_many(self, poses: list[tuple[np.ndarray | None, np.ndarray | None]], camera: str = "front",
                     timeout_s: float = 60.0) -> list[bytes]:
         """JPEGs of (q14, full qpos) poses; qpos wins when it fits the model."""
-        if self._state is None:
-            raise RenderUnavailable(self.error or "renderer not started")
-        return self._pool.submit(self._render_all, poses, camera).result(timeout=timeout_s)
+        with self._lock:
+            if not self.available:
+                raise RenderUnavailable(self.error or "renderer not started")
+            try:
+                return self._child.request((poses, camera), timeout_s)
+            except ChildProcessGone as exc:
+                self.error = str(exc)
+                raise RenderUnavailable(self.error) from exc
 
     def close(self) -> None:
-        def free():
-            state, self._state = self._state, None
-            if state is not None:
-                state["renderer"].close()
+        with self._lock:
+            child, self._child = self._child, None
+        if child is not None:
+            child.close()
 
-        try:
-            self._pool.submit(free).result(timeout=10)
-        except Exception:  # freeing a context at exit must not mask the real outcome
-            log.warning("could not free the web renderer", exc_info=True)
-        self._pool.shutdown(wait=False)
 
-    # -- on the render thread ------------------------------------------------------------------
-    def _init(self) -> None:
+def serve_frames(*settings) -> None:
+    """The render process (started by PoseRenderer.start)."""
+    serve_requests(lambda: _FrameRenderer(*settings).render_all)
+
+
+class _FrameRenderer:
+    """In the render process: a private model copy, its MjData and one offscreen renderer."""
+
+    def __init__(self, model_path, planar_base, width, height, quality, jpeg_quality) -> None:
+        os.nice(RENDER_NICENESS)
         os.environ.setdefault("MUJOCO_GL", "egl")
         import mujoco
 
@@ -89,27 +104,26 @@ class PoseRenderer:
         from emopose.robot.model import build_model
         from emopose.robot.render import OffscreenRenderer
 
-        model = build_model(self.model_path, planar_base=self.planar_base)
-        if self.quality == "fast":  # render-only settings on a private copy; physics never sees it
+        model = build_model(model_path, planar_base=planar_base)
+        if quality == "fast":  # render-only settings on a private copy; physics never sees it
             model.vis.quality.offsamples = 0
             model.light_castshadow[:] = 0
             model.mat_reflectance[:] = 0.0
-        data = mujoco.MjData(model)
-        renderer = OffscreenRenderer(model, self.width, self.height)
-        qadr = np.array([model.joint(n).qposadr[0] for n in JOINT_NAMES])
-        self._state = {"mujoco": mujoco, "model": model, "data": data, "renderer": renderer, "qadr": qadr}
-        self._render_all([(np.zeros(len(qadr)), None)], "front")  # fail here, not on the first request
+        self.mujoco, self.model, self.data = mujoco, model, mujoco.MjData(model)
+        self.renderer = OffscreenRenderer(model, width, height)
+        self.jpeg_quality = jpeg_quality
+        self.qadr = np.array([model.joint(n).qposadr[0] for n in JOINT_NAMES])
+        self.render_all(([(np.zeros(len(self.qadr)), None)], "front"))  # fail here, not on a request
 
-    def _render_all(self, poses, camera: str) -> list[bytes]:
-        s = self._state
-        mujoco, model, data, renderer = s["mujoco"], s["model"], s["data"], s["renderer"]
+    def render_all(self, request) -> list[bytes]:
+        poses, camera = request
         frames = []
         for q, qpos in poses:
-            if qpos is not None and len(qpos) == model.nq:
-                data.qpos[:] = qpos
+            if qpos is not None and len(qpos) == self.model.nq:
+                self.data.qpos[:] = qpos
             elif q is not None:
-                data.qpos[s["qadr"]] = q
-            mujoco.mj_kinematics(model, data)
-            mujoco.mj_camlight(model, data)  # the head camera moves with the body
-            frames.append(encode_jpeg(renderer.render(data, camera), self.jpeg_quality))
+                self.data.qpos[self.qadr] = q
+            self.mujoco.mj_kinematics(self.model, self.data)
+            self.mujoco.mj_camlight(self.model, self.data)  # the head camera moves with the body
+            frames.append(encode_jpeg(self.renderer.render(self.data, camera), self.jpeg_quality))
         return frames

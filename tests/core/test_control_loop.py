@@ -165,13 +165,28 @@ def test_without_sched_fifo_the_thread_is_reniced_and_without_that_left_alone(mo
     assert len(caplog.records) == 1 and "not permitted" in caplog.records[0].getMessage()
 
 
-@pytest.mark.parametrize("priority, expected", [(10, "SCHED_FIFO 10"), (0, "normal")])
+def test_every_thread_of_the_process_is_reniced_or_left_alone(monkeypatch, caplog):
+    """The GIL's holder must not wait behind other processes: every thread gets PROCESS_NICE."""
+    reniced = []
+    monkeypatch.setattr(control_loop.os, "setpriority", lambda *args: reniced.append(args))
+    assert control_loop.raise_process_priority() == f"process nice {control_loop.PROCESS_NICE}"
+    threads = {int(task) for task in os.listdir("/proc/self/task")}
+    assert {tid for _, tid, _ in reniced} == threads and threading.get_native_id() in threads
+    assert {(kind, nice) for kind, _, nice in reniced} == {(os.PRIO_PROCESS, control_loop.PROCESS_NICE)}
+    monkeypatch.setattr(control_loop.os, "setpriority", refuse)
+    with caplog.at_level(logging.WARNING, logger=control_loop.__name__):
+        assert control_loop.raise_process_priority() == "process nice unchanged"
+    assert "not permitted" in caplog.records[0].getMessage()
+
+
+@pytest.mark.parametrize("priority, expected", [(10, "SCHED_FIFO 10; process nice -5"), (0, "normal")])
 def test_start_raises_the_thread_and_shortens_the_switch_interval_until_stop(make_loop, monkeypatch,
                                                                              priority, expected):
     """On the loop's own thread, only when asked; stop() gives the process its switch interval back."""
     asked_from = []
     monkeypatch.setattr(control_loop, "raise_thread_priority",
                         lambda p: asked_from.append(threading.current_thread().name) or f"SCHED_FIFO {p}")
+    monkeypatch.setattr(control_loop, "raise_process_priority", lambda: "process nice -5")
     loop, _, _ = make_loop()
     before = sys.getswitchinterval()
     loop.start(priority)
@@ -191,7 +206,12 @@ def test_the_summary_reports_misses_per_tick():
     assert summary["missed_deadlines"] == 6 and summary["stalls"] == 2
 
 
+@pytest.mark.parametrize("experiment", ["serve", "tour_lab"])
 @pytest.mark.parametrize("priority", [-1, 100, 500])
-def test_an_impossible_loop_priority_is_a_config_error(compose, priority):
+def test_an_impossible_loop_priority_is_a_config_error(compose, experiment, priority):
     with pytest.raises(ConfigError, match=r"run.rt_priority=.*1-99"):
-        build_job(compose("+experiment=serve", f"run.rt_priority={priority}"))
+        build_job(compose(f"+experiment={experiment}", f"run.rt_priority={priority}"))
+
+
+def test_the_tour_takes_the_loop_priority(compose):
+    assert build_job(compose("+experiment=tour_lab", "run.rt_priority=7")).rt_priority == 7

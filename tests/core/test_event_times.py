@@ -25,7 +25,8 @@ def test_recorded_event_times_are_the_events_own_and_never_decrease(library, tmp
     with wired.session:
         for utterance in ("Welcome to the lab!", "Look over there, yes!", "No, I doubt that. Welcome!"):
             wired.runner.run(utterance)
-        expected = [wired.loop.stream_time_of(event.t) for event in wired.sequencer.events]
+        recorder = wired.session.recorder  # recordings are on session time (since the file opened)
+        expected = [recorder.session_time(event.t) for event in wired.sequencer.events]
     recorded = read_recording(tmp_path / "session.mcap")[EVENTS]
     payload_times = [payload["t"] for _, payload in recorded]
     assert len(expected) >= 6 and {"stroke", "completed"} <= {p["kind"] for _, p in recorded}
