@@ -2,13 +2,17 @@
 
     python benchmarks/g1_faults.py [--trials 5] [--domain-id N]
 
-The tests check the bounds in virtual time (tests/backends/g1/test_g1_faults.py); this measures
-how long the real thing takes on this machine, where the supervisor's polling and the scheduler
-add to the bound. Prints one JSON object, for each fault, the delay (ms) from its cause to the
+The tests check the bounds in virtual time (tests/backends/g1/test_g1_faults.py, test_g1_release.py);
+this measures how long the real thing takes on this machine, where the supervisor's polling and the
+scheduler add to the bound. Prints one JSON object, for each fault, the delay (ms) from its cause to the
 backend's release decision:
   lowstate_loss  fake robot SIGKILLed mid-stream (the sequencer keeps sending) -> failure set;
                  bound lowstate_loss_ms = 200
   deadman        last send() of a stream, then silence -> failure set; bound deadman_ms = 100
+and, per injected stall (50-400 ms, in the ramp-up, the stream and the release, each trial), what the
+fake robot received, by the DDS source timestamps: the smallest gap between two commands (>= 10 ms, half
+a period), the most in any 100 ms (5 on the grid, 6 with the one half a period after a stall), and the
+largest per-tick change of kd * dq* + tau in the release, which starts mid-motion (bound 0.5 N m).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import json
 import os
 import random
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -29,7 +34,14 @@ sys.path.insert(0, str(REPO))
 from g1_publish import start_fake  # noqa: E402  (this folder is on sys.path when run as a script)
 
 from emopose.backends.g1 import G1Backend  # noqa: E402
+from emopose.backends.g1.release import MAX_EFFORT_STEP_NM  # noqa: E402
+from emopose.clock import MonotonicClock  # noqa: E402
+from emopose.execution.pacing import DeadlineGrid  # noqa: E402
+from emopose.recording import Recorder, read_recording  # noqa: E402
 from emopose.robot.g1_spec import CONTROL_DT  # noqa: E402
+
+STALLS_S = (0.05, 0.1, 0.2, 0.4)
+LAW = {"kp": 60.0, "kd": 1.5, "velocity_feedforward": True, "gravity_compensation": True}
 
 FAST = {"lowstate_timeout_s": 10.0, "weight_ramp_up_s": 0.2, "weight_ramp_down_s": 0.4,
         "release_blend_s": 0.2, "lowstate_loss_ms": 200, "deadman_ms": 100}
@@ -72,6 +84,54 @@ def trial(domain_id: int, fault: str) -> float:
         fake.wait(timeout=5)
 
 
+class StallingClock(MonotonicClock):
+    """Wall time in which one chosen sleep overruns: the process stalls there for real."""
+
+    def __init__(self) -> None:
+        self.stall: tuple[float, float] | None = None  # (not before, seconds)
+
+    def sleep_until(self, deadline: float) -> None:
+        super().sleep_until(deadline)
+        if self.stall is not None and self.now() >= self.stall[0]:
+            time.sleep(self.stall[1])
+            self.stall = None
+
+
+def stalled_run(domain_id: int, stall_s: float, folder: Path) -> dict:
+    """Ramp-up, 1 s of a fast stream, release, one stall in each; what the fake robot received."""
+    folder.mkdir()
+    log = folder / "fake.jsonl"
+    fake = start_fake(domain_id, "--log", str(log))
+    clock = StallingClock()
+    recorder = Recorder(folder / "run.mcap", clock=clock)  # which phase each command belongs to
+    backend = G1Backend(domain_id=domain_id, clock=clock, **{**FAST, "deadman_ms": 1000, **LAW})
+    try:
+        clock.stall = (clock.now() + 0.3, stall_s)
+        q0 = backend.connect(recorder)
+        clock.stall = (clock.now() + 0.4, stall_s)
+        grid = DeadlineGrid(clock, CONTROL_DT)
+        while (t := grid.wait() - grid.t0) < 1.0 or np.cos(8.0 * t) < 0.9:
+            backend.send(t, q0 + 0.3 * np.sin(8.0 * t))
+            grid.sent()
+        clock.stall = (clock.now() + 0.1, stall_s)
+        backend.close()
+    finally:
+        backend.close()
+        recorder.close()
+        fake.terminate()
+        fake.wait(timeout=5)
+    phases = [p["phase"] for _, p in read_recording(folder / "run.mcap")["/g1/lowcmd"]]
+    arm = [json.loads(line) for line in log.read_text().splitlines() if '"kind": "arm"' in line]
+    if len(arm) != len(phases):
+        raise SystemExit(f"the fake robot heard {len(arm)} of {len(phases)} commands")
+    sent = np.array([a["sent_ns"] for a in arm]) / 1e9
+    effort = np.array([LAW["kd"] * np.array(a["dq"]) + np.array(a["tau"]) for a in arm])
+    first = phases.index("release")  # from the last stream command on
+    return {"min_gap_ms": float(np.diff(sent).min() * 1e3),
+            "max_in_100ms": int((np.searchsorted(sent, sent + 0.1) - np.arange(len(sent))).max()),
+            "release_effort_step_nm": float(np.abs(np.diff(effort[first - 1:], axis=0)).max())}
+
+
 def stats(delays: list[float], bound_ms: float) -> dict:
     a = np.asarray(delays)
     return {"bound_ms": bound_ms, "trials": len(a), "min_ms": round(float(a.min()), 2),
@@ -86,9 +146,18 @@ def main() -> None:
     args = parser.parse_args()
     loss = [trial(args.domain_id, "lowstate_loss") for _ in range(args.trials)]
     deadman = [trial(args.domain_id, "deadman") for _ in range(args.trials)]
+    with tempfile.TemporaryDirectory() as folder:
+        stalls = {f"{stall * 1e3:.0f}ms": [stalled_run(args.domain_id, stall, Path(folder) / f"{stall}_{k}")
+                                           for k in range(args.trials)] for stall in STALLS_S}
+    worst = {key: {"min_gap_ms": round(min(r["min_gap_ms"] for r in runs), 2),
+                   "max_in_100ms": max(r["max_in_100ms"] for r in runs),
+                   "release_effort_step_nm_max": round(max(r["release_effort_step_nm"] for r in runs), 3)}
+             for key, runs in stalls.items()}
     print(json.dumps({"benchmark": "g1_faults", "cpus": os.cpu_count(),
                       "lowstate_loss": stats(loss, FAST["lowstate_loss_ms"]),
-                      "deadman": stats(deadman, FAST["deadman_ms"])}, indent=2))
+                      "deadman": stats(deadman, FAST["deadman_ms"]),
+                      "stalls": {"bound_min_gap_ms": CONTROL_DT / 2 * 1e3,
+                                 "bound_effort_step_nm": MAX_EFFORT_STEP_NM, **worst}}, indent=2))
 
 
 if __name__ == "__main__":

@@ -57,10 +57,10 @@ def stats_ms(samples: np.ndarray) -> dict:
     }
 
 
-def start_fake(domain_id: int) -> subprocess.Popen:
+def start_fake(domain_id: int, *extra: str) -> subprocess.Popen:
     env = {**os.environ, "PYTHONPATH": f"{REPO}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "emopose.testing.fake_robot", "--domain-id", str(domain_id)],
+        [sys.executable, "-m", "emopose.testing.fake_robot", "--domain-id", str(domain_id), *extra],
         cwd=REPO,
         env=env,
         stdout=subprocess.PIPE,
@@ -83,7 +83,7 @@ def measure_link(settings: G1Settings, n: int) -> dict:
         link_s = []
         for i in range(n):
             t0 = time.perf_counter()
-            link.publish(poses[i], 0.0)  # weight 0: the fake keeps its own pose
+            link.publish(poses[i], 0.0, *link.feedforward(poses[i]))  # weight 0: the fake keeps its pose
             link_s.append(time.perf_counter() - t0)
     finally:
         link.close()

@@ -1,24 +1,23 @@
 """The 50 Hz loop: ticks the sequencer on absolute deadlines and hands each target to the backend.
 
 The loop records, on /joints/command, what the backend says it sent (the target after its clamping).
-Deadline n is t0 + n * dt, so lateness never accumulates (no drift from sleep(dt) chains). Deadlines
-that passed a whole period ago, or before the previous command went out, are skipped, not sent in a
-burst: after a stall (or while nobody drove the loop, e.g. the planner was thinking) the loop
-re-anchors on its grid and counts what it skipped; and no command follows the previous one by less
-than half a period. The sequencer samples its motions on the clock and re-times a running gesture after
-a skip (within the speed bound), so a stall never jumps the arm and need not delay the stroke.
+Its deadlines follow the one policy of every command stream (emopose/execution/pacing.py): after a stall
+(or while nobody drove the loop, e.g. the planner was thinking) missed deadlines are skipped, not sent in
+a burst, and counted; no command follows the previous one by less than half a period. The sequencer
+samples its motions on the clock and re-times a running gesture after a skip (within the speed bound),
+so a stall never jumps the arm and need not delay the stroke.
 With a FakeClock the same loop renders a run as fast as the CPU allows; with MonotonicClock it is
 real time. `run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background
 thread for the web UI, speech and the tour; `wait_until()` waits the right way for either.
-Served, the loop shares its process with the web server, rendering, planning and synthesis; `start(
-rt_priority)` puts its thread in SCHED_FIFO (else at a negative nice, else as it was, with one log line) and
-shortens Python's thread switch interval, so neither the OS nor the GIL keeps it waiting for long.
+Served, the loop shares its process with the web server, planning and synthesis (frames and espeak render
+in child processes); `start(rt_priority)` puts its thread in SCHED_FIFO (else at a negative nice, else as
+it was, with one log line), the process's other threads at PROCESS_NICE, and shortens Python's thread
+switch interval, so neither the OS nor the GIL keeps it waiting for long.
 """
 
 from __future__ import annotations
 
 import logging
-import math
 import os
 import sys
 import threading
@@ -32,6 +31,7 @@ import numpy as np
 from emopose import CONTROL_DT
 from emopose.backends.base import Backend
 from emopose.clock import Clock
+from emopose.execution.pacing import DeadlineGrid
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.worker import Worker
 from emopose.recording import Recorder
@@ -39,7 +39,19 @@ from emopose.recording import Recorder
 log = logging.getLogger(__name__)
 
 FALLBACK_NICE = -10  # where SCHED_FIFO is refused but raising the thread's nice value is allowed
+# The process's other threads (web server, planner, speech) in real-time runs. The loop thread needs the
+# GIL on every tick; a thread holding it that other processes keep off the CPU would hold the loop up for
+# as long (priority inversion through the GIL: 700 ms gaps were seen on an overloaded machine).
+PROCESS_NICE = -5
 RT_SWITCH_INTERVAL_S = 0.0005  # GIL hand-over interval while the loop runs on its thread (Python: 5 ms)
+
+
+def check_rt_priority(priority: int) -> int:
+    """run.rt_priority, checked where a job is configured: the OS would refuse a value outside 1-99 and the
+    loop would fall back unnoticed."""
+    if not 0 <= priority <= 99:
+        raise ValueError(f"run.rt_priority={priority}: a SCHED_FIFO priority is 1-99 (0: normal)")
+    return priority
 
 
 def raise_thread_priority(priority: int) -> str:
@@ -58,6 +70,18 @@ def raise_thread_priority(priority: int) -> str:
     except (AttributeError, OSError) as exc:
         log.warning("control loop: real-time priority not permitted (%s); normal scheduling", exc)
         return "normal"
+
+
+def raise_process_priority(nice: int = PROCESS_NICE) -> str:
+    """Every thread of this process (and those it starts later: they inherit it) at `nice`, so that a
+    thread holding the GIL gets the CPU back before other processes' work. Where not permitted, as it was."""
+    try:
+        for task in os.listdir("/proc/self/task"):  # Linux: nice is per thread
+            os.setpriority(os.PRIO_PROCESS, int(task), nice)
+        return f"process nice {nice}"
+    except (AttributeError, OSError) as exc:
+        log.warning("control loop: raising the process's priority not permitted (%s)", exc)
+        return "process nice unchanged"
 
 
 @dataclass
@@ -97,20 +121,21 @@ class ControlLoop:
         self.sequencer, self.backend, self.clock, self.dt = sequencer, backend, clock, dt
         self.recorder: Recorder | None = None
         self.stats = LoopStats()
-        self._t0: float | None = None
-        self._tick = 0
-        self._last_sent = -np.inf  # clock time the previous command went out
+        self._grid = DeadlineGrid(clock, dt)
+        self._begun = False
         self._resuming = True  # nobody drove the loop since the last tick: lag is idle time, not a stall
         self._worker = Worker("emopose-control", self._run, join_timeout_s=2.0)
         self._rt_priority = 0
         self._saved_switch_interval: float | None = None
+        self._process_scheduling = "process nice unchanged"
         self.error: BaseException | None = None
+        sequencer.stroke_watch.measuring = backend.measures_joints  # STROKE from the measured joints
 
     def begin(self, q0: np.ndarray, recorder: Recorder | None = None) -> None:
         """Start the stream at the measured pose q0, recording every command to `recorder`."""
         self.recorder = recorder
-        self._t0 = self.clock.now()
-        self._tick = 0
+        self._grid.restart(self.clock.now())
+        self._begun = True
         self._resuming = True
         self.sequencer.reset(q0, self._t0)
         if recorder is not None:
@@ -119,37 +144,38 @@ class ControlLoop:
             recorder.start_stream(self._t0)
 
     @property
+    def _t0(self) -> float:
+        """The stream's zero on the clock (0 before begin())."""
+        return self._grid.t0 if self._begun else 0.0
+
+    @property
     def stream_time(self) -> float:
-        return self.clock.now() - (self._t0 or 0.0)
+        return self.clock.now() - self._t0
 
     def stream_time_of(self, clock_time: float) -> float:
         """A time read from the loop's clock, on the stream's time base (the `t` of /joints/command)."""
-        return clock_time - (self._t0 or 0.0)
+        return clock_time - self._t0
 
     def tick(self) -> np.ndarray:
         """Wait for the next deadline, send the sequencer's target; returns (and records) what was sent."""
-        deadline = self._t0 + (self._tick + 1) * self.dt
-        # Deadlines a whole period past, or at or before the previous send (it stood for them), are
-        # skipped: the loop re-anchors on the grid instead of bursting the backlog out.
-        covered = max(self.clock.now() - self.dt, self._last_sent)
-        behind = math.floor((covered - deadline) / self.dt + 1e-9) + 1 if covered >= deadline - 1e-12 else 0
+        behind = self._grid.skip_missed()
         if behind > 0:
-            self._tick += behind
-            deadline = self._t0 + (self._tick + 1) * self.dt
             if self._resuming:
                 self.stats.idle_ticks += behind
             else:
                 self.stats.missed_deadlines += behind
                 self.stats.stalls += 1
         self._resuming = False
-        self.clock.sleep_until(max(deadline, self._last_sent + self.dt / 2))
+        self.clock.sleep_until(self._grid.send_at())
+        deadline = self._grid.take()
         self.stats.add(self.clock.now() - deadline)
-        self._tick += 1
         t = deadline - self._t0
         sent = self.backend.send(t, self.sequencer.step(deadline))
-        self._last_sent = self.clock.now()
+        self._grid.sent()
         if self.recorder is not None:
             self.recorder.write("/joints/command", t, {"t": t, "q": sent.tolist()})
+        if self.backend.measures_joints and (measured := self.backend.measured()) is not None:
+            self.sequencer.observe(deadline + self.backend.measured_lead_s, measured)
         return sent
 
     def run_until(self, done: Callable[[], bool], timeout_s: float) -> bool:
@@ -184,11 +210,12 @@ class ControlLoop:
         if rt_priority > 0 and self._saved_switch_interval is None:
             self._saved_switch_interval = sys.getswitchinterval()
             sys.setswitchinterval(RT_SWITCH_INTERVAL_S)
+            self._process_scheduling = raise_process_priority()
         self._worker.start()
 
     def _run(self, stop: threading.Event) -> None:
         if self._rt_priority > 0:
-            self.stats.scheduling = raise_thread_priority(self._rt_priority)
+            self.stats.scheduling = f"{raise_thread_priority(self._rt_priority)}; {self._process_scheduling}"
         try:
             while not stop.is_set():
                 self.tick()

@@ -4,7 +4,8 @@ Modules, data path order: settings (config validation) -> backend (G1Backend) ->
 and every transition) -> handover (weight ramps, release) -> output (every LowCmd_ out, paced and
 recorded) -> link (DDS participant, rt/lowstate monitor, rt/arm_sdk writer) -> arm_command (LowCmd_
 build) -> wire + crc (packed C layout, CDR bytes, CRC); supervisor (watchdog, release on faults);
-profiles (weight ramps, blends); loco (LocoClient RPC); hg_types/api_types (IDL). The fake G1 for
+profiles (weight ramps, blends); release (the release plan, its per-tick bound); torso (gravity under
+the measured torso); loco (LocoClient RPC); hg_types/api_types (IDL). The fake G1 for
 tests and benchmarks lives in emopose.testing.
 
 The names below are loaded on first use (PEP 562), and no module of this package imports the

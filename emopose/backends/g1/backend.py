@@ -40,6 +40,7 @@ log = logging.getLogger(__name__)
 class G1Backend(Backend):
     name = "g1"
     realtime = True  # a real robot: the loop runs on the wall clock, never virtual time
+    measures_joints = True  # LowState's arm joints
 
     def __init__(
         self,
@@ -91,7 +92,7 @@ class G1Backend(Backend):
             raise
         self._life.connected()
         s = self.settings
-        self._supervisor = Supervisor(self, self._clock.now, s.lowstate_loss_s, s.deadman_s)
+        self._supervisor = Supervisor(self, self._clock, s.lowstate_loss_s, s.deadman_s)
         self._supervisor.start()
         return hold.copy()
 
@@ -164,7 +165,7 @@ class G1Backend(Backend):
     def hold(self) -> None:
         with self._life.lock:
             if self._life.state is ArmState.HOLDING:
-                self._out.publish(self._out.last_q, 1.0, "hold")
+                self._out.publish(self._out.last.q, 1.0, "hold")
 
     def fail(self, reason: str) -> None:
         if not self._life.claim_release(fault=reason):
@@ -195,6 +196,7 @@ class G1Backend(Backend):
                 "(the weight ramp makes the move gradual)",
                 np.flatnonzero(hold != measured).tolist(),
             )
+        self._link.reset_feedforward(hold)  # the first ramp tick's dq* is 0, even from outside the limits
         # No configured neutral pose: hand back where the firmware had the arms.
         neutral = hold.copy() if s.neutral_pose is None else s.neutral_pose
         self._out = ArmOutput(self._link, self._clock, recorder, hold)

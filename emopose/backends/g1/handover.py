@@ -1,8 +1,12 @@
 """Handing the arms to the SDK and back: the weight ramp-up at connect, the release sequence.
 
-Both directions move only smoothly: the weight follows profiles.ramp, the targets profiles.blend,
-one LowCmd_ per 20 ms tick on absolute deadlines, each through the backend's ArmOutput under the
-lifecycle lock. The release runs on whichever thread claimed it (close() or the supervisor).
+Both directions move only smoothly: the weight follows profiles.ramp; the release follows its plan
+(release.py: targets, weight and feed-forwards, bounded per tick). One LowCmd_ per 20 ms tick, paced
+by the one deadline policy of every command stream (emopose/execution/pacing.py): after a stall the
+missed deadlines are skipped, not sent in a burst, and the ramp goes on with its next step (a step is
+never skipped: each tick changes the command by no more than planned). Each command goes through the
+backend's ArmOutput under the lifecycle lock. The release runs on whichever thread claimed it (close()
+or the supervisor).
 """
 
 from __future__ import annotations
@@ -15,9 +19,11 @@ from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.errors import G1ConnectionError
 from emopose.backends.g1.lifecycle import Lifecycle
 from emopose.backends.g1.output import ArmOutput
-from emopose.backends.g1.profiles import ramp, release_plan
+from emopose.backends.g1.profiles import ramp
+from emopose.backends.g1.release import plan_release
 from emopose.backends.g1.settings import G1Settings
 from emopose.clock import Clock
+from emopose.execution.pacing import DeadlineGrid
 from emopose.robot.g1_spec import CONTROL_DT
 
 log = logging.getLogger(__name__)
@@ -38,11 +44,10 @@ class Handover:
     def ramp_up(self) -> None:
         """Weight 0 -> 1 while holding the measured pose; lost state on the way refuses the start."""
         s, out = self._settings, self._out
-        hold = out.last_q.copy()
-        deadline = self._clock.now()
+        hold = out.last.q.copy()
+        grid = DeadlineGrid(self._clock, CONTROL_DT)
         for w in ramp(0.0, 1.0, s.weight_ramp_up_s, CONTROL_DT):
-            deadline += CONTROL_DT
-            self._clock.sleep_until(deadline)
+            grid.wait()
             if out.link.state_age() > s.lowstate_loss_s:
                 raise G1ConnectionError(
                     f"lost {TOPIC_LOWSTATE} while ramping the arm_sdk weight up "
@@ -50,32 +55,31 @@ class Handover:
                 )
             with self._life.lock:
                 out.publish(hold, float(w), "ramp_up")
+            grid.sent()
 
     def release(self, reason: str | None, blend: bool = True) -> None:
-        """Blend to neutral, ramp the weight to 0, stop; the caller claimed the release. A Ctrl-C
-        during the few-second hand-back is held until it is done: stopping half-way would leave
-        the arms under SDK weight with nobody commanding them."""
+        """Blend to neutral, ramp the weight to 0, stop; the caller claimed the release. blend=False (or
+        release_blend_s 0) hands the arms back where they are. A Ctrl-C during the few-second hand-back
+        is held until it is done: stopping half-way would leave the arms under SDK weight with nobody
+        commanding them."""
         s, out = self._settings, self._out
-        out.record("/g1/event", {"event": "release", "reason": reason, "weight": out.weight})
-        poses, weights = release_plan(
-            out.last_q.copy(),
-            self._neutral,
-            out.weight,
-            s.release_blend_s if blend else 0.0,
-            s.weight_ramp_down_s,
-            CONTROL_DT,
-        )
+        blend_s = s.release_blend_s if blend else 0.0
+        with self._life.lock:  # the gravity model is the publishers' (they publish under this lock)
+            start = out.last
+            plan = plan_release(start, self._neutral, blend_s, s.weight_ramp_down_s, out.link.feed_law())
+        out.record("/g1/event", {"event": "release", "reason": reason, "weight": start.weight,
+                                 "ticks": len(plan), "effort_step_nm": plan.effort_step(start, s.kd)})
         interrupted: BaseException | None = None
-        deadline = self._clock.now()
-        for q, w in zip(poses, weights):
-            deadline += CONTROL_DT
+        grid = DeadlineGrid(self._clock, CONTROL_DT)
+        for command in plan.commands():
             try:
-                self._clock.sleep_until(deadline)
+                grid.wait()
             except KeyboardInterrupt as exc:  # finish the hand-back first, re-raise after
                 interrupted = exc
             try:
                 with self._life.lock:
-                    out.publish(q, float(w), "release")
+                    out.publish(command.q, command.weight, "release", feed=(command.dq, command.tau))
+                grid.sent()
             except KeyboardInterrupt as exc:
                 interrupted = exc
             except Exception:

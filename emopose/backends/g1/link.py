@@ -16,10 +16,13 @@ from emopose.backends.g1.constants import TOPIC_ARM_SDK, TOPIC_LOWSTATE
 from emopose.backends.g1.dds import DdsSession
 from emopose.backends.g1.errors import G1ConnectionError
 from emopose.backends.g1.hg_types import LowCmd_
+from emopose.backends.g1.release import FeedLaw
 from emopose.backends.g1.settings import G1Settings
 from emopose.backends.g1.state_monitor import LowStateMonitor
+from emopose.backends.g1.torso import TorsoGravity
 from emopose.robot.arm_law import ArmLaw
-from emopose.robot.feedforward import Feedforward
+from emopose.robot.feedforward import Feedforward, GravityModel
+from emopose.robot.g1_spec import CONTROL_DT
 
 log = logging.getLogger(__name__)
 
@@ -38,7 +41,9 @@ class G1Link:
         self._builder: ArmCommandBuilder | None = None
         law = ArmLaw("g1", settings.kp.tolist(), settings.kd.tolist(), settings.velocity_feedforward,
                      settings.gravity_compensation)
-        self._feedforward = Feedforward(law)  # dq and tau of every command, as MuJoCo applies them
+        # dq and tau of every command, as MuJoCo applies them; gravity under the measured torso
+        gravity = TorsoGravity(GravityModel(), self.monitor.torso) if law.gravity_compensation else None
+        self._feedforward = Feedforward(law, gravity)
 
     def where(self) -> str:
         return self.session.describe()
@@ -62,13 +67,25 @@ class G1Link:
             )
         waist = monitor.waist_q() if s.command_waist else None
         self._builder = ArmCommandBuilder(s.kp, s.kd, waist, s.waist_kp, s.waist_kd)
-        measured = monitor.arm_q()
-        self._feedforward.reset(measured)
-        return measured
+        return monitor.arm_q()
 
-    def publish(self, q: np.ndarray, weight: float) -> int:
+    def reset_feedforward(self, hold: np.ndarray) -> None:
+        """The stream starts holding `hold` (the measured pose, clamped): no velocity reference yet."""
+        self._feedforward.reset(hold)
+
+    def feedforward(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(dq*, tau) of the arm law for the next target q."""
+        return self._feedforward(q)
+
+    def feed_law(self) -> FeedLaw:
+        """What a release plans its feed-forwards with."""
+        law = self._feedforward.law
+        return FeedLaw(self.settings.kd, law.velocity_feedforward, self._feedforward.gravity
+                       if law.gravity_compensation else None, CONTROL_DT)
+
+    def publish(self, q: np.ndarray, weight: float, dq: np.ndarray, tau: np.ndarray) -> int:
         """Build, CRC and write one LowCmd_; returns the CRC. Not thread-safe (backend locks)."""
-        cdr, crc = self._builder.build(q, weight, *self._feedforward(q))
+        cdr, crc = self._builder.build(q, weight, dq, tau)
         self._writer.write(cdr)
         return crc
 

@@ -1,4 +1,5 @@
-"""Background reader of rt/lowstate: keeps the newest valid-CRC state and how old it is.
+"""Background reader of rt/lowstate: keeps the newest valid-CRC state (arms, waist, the IMU's roll,
+pitch and yaw) and how old it is.
 
 A LowState_ whose CRC fails is counted and dropped, exactly as the firmware treats a bad LowCmd_;
 the backend refuses to start on, and releases the arms after losing, *valid* state only.
@@ -33,6 +34,7 @@ class LowStateMonitor:
         self._first = threading.Event()
         self._arm_q: np.ndarray | None = None
         self._waist_q: np.ndarray | None = None
+        self._imu_rpy: np.ndarray | None = None
         self._stamp = -np.inf
         self.valid = 0
         self.bad_crc = 0
@@ -55,6 +57,11 @@ class LowStateMonitor:
     def waist_q(self) -> np.ndarray | None:
         with self._lock:
             return None if self._waist_q is None else self._waist_q.copy()
+
+    def torso(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(waist yaw, roll, pitch), (IMU roll, pitch, yaw) of the same state; None before the first."""
+        with self._lock:
+            return None if self._waist_q is None else (self._waist_q.copy(), self._imu_rpy.copy())
 
     def age(self) -> float:
         """Seconds since the newest valid state arrived (inf before the first one)."""
@@ -86,6 +93,7 @@ class LowStateMonitor:
         with self._lock:
             self._arm_q = q[_ARM].astype(float)
             self._waist_q = q[_WAIST].astype(float)
+            self._imu_rpy = record["imu_state"]["rpy"].astype(float)
             self._stamp = self._now()
             self.valid += 1
         self._first.set()

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import logging
 import threading
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
 from emopose.backends.g1.constants import TOPIC_LOWSTATE
 from emopose.backends.g1.lifecycle import ACTIVE, ArmState
+from emopose.clock import Clock
+from emopose.execution.pacing import DeadlineGrid
 from emopose.execution.worker import Worker
 from emopose.robot.g1_spec import CONTROL_DT
 
@@ -59,11 +60,11 @@ class Supervisor:
     def __init__(
         self,
         target: Supervised,
-        now: Callable[[], float],
+        clock: Clock,
         lowstate_loss_s: float,
         deadman_s: float,
     ) -> None:
-        self._target, self._now = target, now
+        self._target, self._clock = target, clock
         self._loss_s, self._deadman_s = lowstate_loss_s, deadman_s
         # Check at least 4x per deadman period so a stall is seen within ~1.25x the limit.
         self._period = min(0.005, deadman_s / 4, lowstate_loss_s / 4)
@@ -77,7 +78,7 @@ class Supervisor:
         self._worker.stop()
 
     def _run(self, stop: threading.Event) -> None:
-        next_hold = self._now() + CONTROL_DT
+        holds = DeadlineGrid(self._clock, CONTROL_DT)  # the holds keep the one deadline policy
         while not stop.wait(self._period):
             vitals = self._target.vitals()
             if vitals.state not in ACTIVE:
@@ -86,7 +87,8 @@ class Supervisor:
             if reason is not None:
                 self._target.fail(reason)
                 return
-            t = self._now()
-            if vitals.state is ArmState.HOLDING and t >= next_hold:
+            holds.skip_missed()  # a late wake-up re-anchors on the grid: no burst
+            if vitals.state is ArmState.HOLDING and holds.due():
+                holds.take()
                 self._target.hold()
-                next_hold = max(next_hold + CONTROL_DT, t)  # no burst after a late wake-up
+                holds.sent()

@@ -1,15 +1,18 @@
-"""g1_check end to end against the fake G1 on loopback DDS (a separate process), and its faults as
-results: results.json/results.md written, times relative to the run, a non-zero exit, no traceback."""
+"""g1_check end to end against the fake G1 on loopback DDS (a separate process), and robot faults as
+results in every job (g1_check and plan here, one mechanism: emopose/jobs/robot_fault.py):
+results.json/results.md written, times relative to the run, exit 3 with one line, no traceback."""
 
 import json
 import os
 import subprocess
 import sys
+import threading
 
 import pytest
 
 from emopose import app
 from emopose.config import PROJECT_ROOT
+from emopose.jobs.robot_fault import ROBOT_FAULT_EXIT, RobotFault
 from tests.backends.g1.conftest import FakeRobot, require_dds  # noqa: F401 (domain_id fixture)
 
 FAST = ("backend.weight_ramp_up_s=0.2", "backend.weight_ramp_down_s=0.5", "backend.release_blend_s=0.5")
@@ -50,9 +53,9 @@ def test_no_robot_is_a_fault_result_not_a_traceback(tmp_path, domain_id, compose
     require_dds()
     cfg = compose("+experiment=g1_check", "planner=keyword", f"backend.domain_id={domain_id}",
                   "backend.lowstate_timeout_s=0.3")
-    with pytest.raises(SystemExit) as exit_:
+    with pytest.raises(RobotFault) as fault:
         app.run(cfg, tmp_path)
-    assert "g1_check: FAULT" in str(exit_.value.code) and "rt/lowstate" in str(exit_.value.code)
+    assert "G1CheckJob: robot FAULT" in str(fault.value) and "rt/lowstate" in str(fault.value)
     results = results_of(tmp_path)
     assert "refusing to start" in results["fault"] and not results["completed"]
     assert 0 <= results["fault_at_s"] < 30 and results["events"] == []
@@ -66,24 +69,48 @@ def test_robot_lost_mid_gesture_is_a_fault_result(tmp_path, domain_id, compose):
     try:
         cfg = compose("+experiment=g1_check", "planner=keyword", f"backend.domain_id={domain_id}", *FAST,
                       "job.gesture=chop_right", "backend.lowstate_timeout_s=5")
-        with pytest.raises(SystemExit):
+        with pytest.raises(RobotFault):
             app.run(cfg, tmp_path)
     finally:
         robot.stop()
     results = results_of(tmp_path)
     assert "rt/lowstate" in results["fault"] and not results["completed"]
-    assert 0 < results["fault_at_s"] < 30
+    assert 0 < results["fault_at_s"] < 30 and results["gesture"] == "chop_right"
     assert all(0 < t <= results["fault_at_s"] for _, _, t in results["events"])
 
 
 @pytest.mark.slow
-def test_cli_fault_exits_nonzero_with_one_line(tmp_path, domain_id):
+def test_plan_on_a_robot_lost_mid_turn_is_a_fault_result(tmp_path, domain_id, compose):
+    """Before, plan ended a G1 fault in a traceback with no results.json."""
     require_dds()
-    env = {**os.environ, "HYDRA_FULL_ERROR": "1", "HF_HUB_OFFLINE": "1"}
-    done = subprocess.run([sys.executable, "-m", "emopose", "+experiment=g1_check", "planner=keyword",
+    robot = FakeRobot(domain_id, tmp_path / "fake.jsonl", [])
+    # It vanishes mid-turn: after 40 commands (0.8 s of the stream, past the 0.2 s ramp-up), planning
+    # and synthesis before the session opens taking whatever they take.
+    vanish = threading.Thread(target=lambda: (robot.wait_for("arm", 40, timeout_s=120), robot.kill()))
+    vanish.start()
+    try:
+        cfg = compose("+experiment=plan", "planner=keyword", "backend=g1", f"backend.domain_id={domain_id}",
+                      *FAST, "backend.lowstate_timeout_s=5",
+                      "utterance='Welcome everyone, please look over there at the big screen.'")
+        with pytest.raises(RobotFault, match="PlanJob: robot FAULT at .* lost rt/lowstate"):
+            app.run(cfg, tmp_path)
+    finally:
+        vanish.join()
+        robot.stop()
+    results = results_of(tmp_path)
+    assert "rt/lowstate" in results["fault"] and not results["completed"] and results["job"] == "PlanJob"
+    assert results["utterance"].startswith("Welcome") and 0 < results["fault_at_s"] < 30
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("job", ["+experiment=g1_check", "+experiment=plan"])
+def test_cli_fault_exits_3_with_one_line(tmp_path, domain_id, job):
+    require_dds()
+    env = {**os.environ, "HF_HUB_OFFLINE": "1"}
+    done = subprocess.run([sys.executable, "-m", "emopose", job, "planner=keyword", "backend=g1",
                            f"backend.domain_id={domain_id}", "backend.lowstate_timeout_s=0.3",
                            f"hydra.run.dir={tmp_path}"],
                           cwd=PROJECT_ROOT, env=env, capture_output=True, text=True, timeout=300)
-    assert done.returncode != 0 and "Traceback" not in done.stderr, done.stderr[-2000:]
-    assert "g1_check: FAULT" in done.stderr
-    assert results_of(tmp_path)["fault"]
+    assert done.returncode == ROBOT_FAULT_EXIT and "Traceback" not in done.stderr, done.stderr[-2000:]
+    assert "robot FAULT" in done.stderr.strip().splitlines()[-1]
+    assert "refusing to start" in results_of(tmp_path)["fault"]

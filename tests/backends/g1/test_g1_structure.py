@@ -104,7 +104,7 @@ class Stub:
 def test_supervisor_trips_the_deadman_through_the_narrow_interface():
     clock = FakeClock()
     stub = Stub(clock)
-    supervisor = Supervisor(stub, clock.now, lowstate_loss_s=0.2, deadman_s=0.1)
+    supervisor = Supervisor(stub, clock, lowstate_loss_s=0.2, deadman_s=0.1)
     supervisor.start()
     clock.advance(0.09)
     assert not stub.failed.wait(0.05)

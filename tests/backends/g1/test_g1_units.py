@@ -96,13 +96,11 @@ def test_weight_ramp_monotone_bounded_smooth(duration):
     assert steps[0] < steps.max() / 5  # eases in: no jump at the start
 
 
-def test_release_plan_blends_then_ramps_to_zero():
-    q_from, neutral = np.full(14, 0.8), np.zeros(14)
-    poses, weights = profiles.release_plan(q_from, neutral, 1.0, 0.5, 1.0, DT)
-    assert len(poses) == len(weights) == 25 + 50
-    assert np.all(weights[:25] == 1.0) and weights[-1] == 0.0 and np.all(np.diff(weights) <= 0)
-    assert np.array_equal(poses[24], neutral) and np.all(poses[25:] == neutral)
-    assert np.abs(np.diff(poses, axis=0)).max() <= profiles.max_step(0.5, DT, 0.8) + 1e-12
-    # A partial weight ramps down in proportionally less time.
-    _, half = profiles.release_plan(q_from, neutral, 0.5, 0.0, 1.0, DT)
-    assert len(half) == 25 and half[0] < 0.5 and half[-1] == 0.0
+@pytest.mark.parametrize("setting, refused", [("virtual", "real robot"), ("fake", "is not a clock")])
+def test_the_g1_refuses_virtual_time_and_unknown_clocks(compose, tmp_path, setting, refused):
+    """Issue 30 item 3 (fixed in emopose/clock.py): run.clock=virtual, or anything outside the closed set,
+    never drives a real robot at CPU speed; building the run refuses it before anything connects."""
+    from emopose.build import ConfigError, build_run
+
+    with pytest.raises(ConfigError, match=refused):
+        build_run(compose("planner=keyword", "backend=g1", f"run.clock={setting}"), tmp_path)
