@@ -51,8 +51,8 @@ def test_chat_planners_take_one_client_node_and_copy_none_of_its_settings(compos
 @pytest.mark.parametrize("experiment", options("experiment"))
 def test_every_experiment_composes_and_builds_its_job(experiment, tmp_path, compose):
     recording = tmp_path / "session.mcap"
-    recording.touch()
-    required = {"replay": [f"mcap={recording}"]}  # experiments with a mandatory argument
+    recording.write_bytes(b"\x89MCAP0\r\n")  # the MCAP magic: what a job checks before it loads anything
+    required = {"replay": [f"mcap={recording}"], "recording_report": [f"recording={recording}"]}
     cfg = compose(f"+experiment={experiment}", *required.get(experiment, []))
     job = instantiate(cfg.job, _convert_="all")
     assert callable(job)

@@ -17,8 +17,9 @@ PACKAGE = Path(__file__).resolve().parents[1] / "emopose"
 # Bottom to top. A module may import from its own layer or a lower one. Within "know" the order of the
 # sub-layers matters too: the LLM client and speech sit below the planners, which may use both.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
-    ("base", ("emopose", "emopose.config", "emopose.robot", "emopose.clock", "emopose.recording",
-              "emopose.results", "emopose.sentences", "emopose.scene")),
+    ("base", ("emopose", "emopose.config", "emopose.robot", "emopose.clock", "emopose.child_process",
+              "emopose.recording", "emopose.recording_schemas", "emopose.recover", "emopose.results",
+              "emopose.sentences", "emopose.scene")),
     ("know: contract", ("emopose.contract", "emopose.joint_limits", "emopose.library")),
     ("know: llm", ("emopose.llm",)),
     ("know: speech", ("emopose.speech",)),

@@ -29,7 +29,7 @@ import numpy as np
 from emopose.backends.base import Backend
 from emopose.backends.planar_base import MujocoPlanarBase
 from emopose.backends.sim_renderer import SimRenderer
-from emopose.recording import Recorder
+from emopose.recording import Recorder, joint_state
 from emopose.robot.arm_law import ArmLaw
 from emopose.robot.feedforward import Feedforward, GravityModel
 from emopose.robot.g1_spec import CONTROL_DT, JOINT_NAMES, NUM_JOINTS
@@ -42,6 +42,8 @@ class MujocoBackend(Backend):
     """Satisfies capabilities.SimulatedState and capabilities.Renderable."""
 
     name = "mujoco"
+    measures_joints = True
+    measured_lead_s = CONTROL_DT  # send() steps the physics through the period it commands
 
     def __init__(
         self,
@@ -151,15 +153,14 @@ class MujocoBackend(Backend):
                 self._mj.mj_step(self.model, self.data)
                 tau = self.data.qfrc_actuator[self._dadr]
                 ratio = max(ratio, float(np.max(np.abs(tau) / self._tau_limit)))
-            q_sim = self.data.qpos[self._qadr].copy()
+            q_sim, dq_sim = self.data.qpos[self._qadr].copy(), self.data.qvel[self._dadr].copy()
         self.max_actuator_force_ratio = max(self.max_actuator_force_ratio, ratio)
         self._tick += 1
         if self._recorder is not None:
             t_sim = t + CONTROL_DT
-            self._recorder.write("/joints/sim", t_sim, {"t": t_sim, "q": q_sim.tolist()})
-            self._recorder.write(
-                "/joints/torque", t_sim, {"t": t_sim, "tau": tau.tolist(), "ratio": ratio}
-            )
+            self._recorder.write("/joints/sim", t_sim, {"q": q_sim.tolist()})  # the recorder stamps t
+            self._recorder.write("/joints/torque", t_sim, {"tau": tau.tolist(), "ratio": ratio})
+            self._recorder.write("/joint_states", t_sim, joint_state(q_sim, dq_sim, tau))
         self.renderer.after_tick(self._tick)
         if self._viewer is not None and self._viewer.is_running():
             self._viewer.sync()

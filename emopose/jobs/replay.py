@@ -25,12 +25,14 @@ from emopose.results import JobOutput
 
 def command_grid(rows: list[tuple[float, dict]], dt: float = CONTROL_DT) -> tuple[np.ndarray, np.ndarray]:
     """(times, (T, 14) commands) on a dt grid from recorded (t, {"q": [...]}) messages."""
-    stamped = {}
+    stamped, first = {}, None
     for t, payload in rows:
         q = payload.get("q") if isinstance(payload, dict) else None
         if q is None or len(q) != NUM_JOINTS:
             raise ValueError(f"replay: a command message at t={t:.3f} s has no {NUM_JOINTS}-value 'q'")
-        stamped.setdefault(round(float(payload.get("t", t)) / dt), np.asarray(q, dtype=float))
+        at = float(payload.get("t", t))
+        first = at if first is None else first  # ticks counted from the first: session time is off-grid
+        stamped.setdefault(round((at - first) / dt), np.asarray(q, dtype=float))
     ticks = np.array(sorted(stamped))
     grid = np.arange(ticks[0], ticks[-1] + 1)
     held = ticks[np.searchsorted(ticks, grid, side="right") - 1]  # latest recorded tick at or before

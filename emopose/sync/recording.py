@@ -1,10 +1,11 @@
 """What a recording needs so its speech-gesture sync can be measured again from session.mcap alone.
 
-Two channels, both on the control stream's time base (the `t` of /joints/command):
+Two channels, on the recording's session clock like every time in it (the `t` of /joints/command):
   /sequencer/events  every sequencer event as it happens: {t, kind, name, command_id, detail}
-  /speech/timeline   per dispatched turn: the speech start and duration, each word's onset and text
-                     span, and per planned gesture its command, stroke-start keyframe, trigger onset,
-                     planned stroke arrival and drop reason.
+  /speech/timeline   per dispatched turn, the planned and executed timeline: the speech start and
+                     duration, each word's onset and text span, and per planned gesture its command,
+                     stroke-start keyframe, trigger onset, planned and executed stroke arrival (s from
+                     speech start) and drop reason.
 `read_stroke_sync(path)` rebuilds the streams and runs the same measurement as sync_eval.
 """
 
@@ -15,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from emopose import STROKE_TOLERANCE
-from emopose.contract import trigger_position
+from emopose.contract import EventKind, trigger_position
 from emopose.recording import read_recording
 from emopose.sync.strokes import PlannedStroke, Streams, StrokeSync, measure_strokes, planned_strokes
 
@@ -23,20 +24,24 @@ EVENTS, TIMELINE = "/sequencer/events", "/speech/timeline"
 
 
 def event_message(event, stream_t: float) -> dict:
-    """A sequencer event as recorded on /sequencer/events, at its stream time."""
+    """A sequencer event as recorded on /sequencer/events, at its stream time (Recorder.write puts `t` on
+    the session clock)."""
     return {"t": stream_t, "kind": event.kind, "name": event.name, "command_id": event.command_id,
             "detail": event.detail}
 
 
-def speech_timeline(turn, speech_start: float) -> dict:
-    """A dispatched turn's /speech/timeline message; `speech_start` is on the stream's time base."""
-    speech, plan = turn.speech, turn.plan
+def speech_timeline(turn) -> dict:
+    """A dispatched turn's /speech/timeline message, its times read from the loop's clock (as
+    Recorder.write_now takes them)."""
+    speech, plan, speech_start = turn.speech, turn.plan, turn.dispatched.speech_start
+    strokes = {e.command_id: e.t - speech_start for e in turn.dispatched.events if e.kind == EventKind.STROKE}
     gestures = []
     for stroke, record in zip(planned_strokes(turn), (m.resolved.record for m in turn.schedule.gestures)):
         position = trigger_position(plan.reply, record.trigger)
         gestures.append({"k": stroke.k, "motion": stroke.motion, "command_id": stroke.command_id,
                          "keyframe": stroke.keyframe.tolist(), "planned_s": stroke.planned_s,
-                         "dropped": stroke.dropped, "trigger": record.trigger,
+                         "executed_s": strokes.get(stroke.command_id), "dropped": stroke.dropped,
+                         "trigger": record.trigger,
                          "onset_s": None if position is None else speech.onset_at_char(position)})
     return {"speech_start": speech_start, "duration_s": speech.duration_s,
             "text": speech.text, "preroll_s": turn.schedule.preroll_s,

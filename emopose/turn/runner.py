@@ -44,6 +44,7 @@ class TurnRunner:
 
     def __post_init__(self) -> None:
         self._recorded = self.pipeline.with_hooks(self._recording_hook)
+        self.dialogue.on_message = self.session.write  # each message once, on /dialogue
         self._stream: SentencePlans | None = None  # the reply streaming now, for cancel()
         self._stream_lock = threading.Lock()
 
@@ -181,8 +182,7 @@ class TurnRunner:
         for name in stage.writes:
             self._record(turn, name)
         if "dispatched" in stage.writes and self.session.recording:  # enough to re-measure the sync
-            speech_start = self.session.loop.stream_time_of(turn.dispatched.speech_start)
-            self.session.write(TIMELINE, speech_timeline(turn, speech_start))
+            self.session.write(TIMELINE, speech_timeline(turn))
 
     def _record(self, turn: Turn, name: str) -> None:
         if not self.session.recording:

@@ -1,0 +1,48 @@
+"""python -m tests.recording.witness OVERRIDES...: `python -m emopose OVERRIDES...` with a witness of every
+recorded message, for the kill -9 tests.
+
+Each message the Recorder takes is logged as one line `<wall ns> <log time ns> <topic>` to the file named
+by $EMOPOSE_WITNESS, with an unbuffered write(2) straight after the Recorder's own call: a SIGKILL
+leaves every line the kernel took, so the test knows which messages existed at any wall time before the
+kill (a virtual-clock job's log times say nothing about the wall clock).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+
+from emopose.recording import Recorder
+
+WITNESS = "EMOPOSE_WITNESS"
+
+
+def witness_every_message(fd: int) -> None:
+    record = Recorder._add
+
+    def witnessed(self, topic, offset_s, payload, from_clock=False):
+        was_closed = self._closed.is_set()  # a closed recorder drops the message
+        record(self, topic, offset_s, payload, from_clock)
+        if not was_closed:
+            stamp = self.start_ns + int(round(offset_s * 1e9))  # the log time Recorder._add gave it
+            os.write(fd, f"{time.time_ns()} {stamp} {topic}\n".encode())
+
+    Recorder._add = witnessed
+
+
+def read_witness(path) -> list[tuple[int, int, str]]:
+    """(wall ns, log time ns, topic) of every witnessed message."""
+    rows = []
+    for line in path.read_text().splitlines():
+        wall, stamp, topic = line.split(" ", 2)
+        rows.append((int(wall), int(stamp), topic))
+    return rows
+
+
+if __name__ == "__main__":
+    witness_every_message(os.open(os.environ[WITNESS], os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644))
+    from emopose.__main__ import cli
+
+    sys.argv = ["emopose", *sys.argv[1:]]
+    cli()
