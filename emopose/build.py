@@ -98,6 +98,7 @@ def check_planner(planner: Planner) -> None:
 
 
 def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
+    make(cfg.get("arm_law"), "arm_law")  # the law validates itself, whichever backend (if any) applies it
     library = make(cfg.library, "library")
     planner = make_with(cfg.planner, "planner", {"library": library})
     check_planner(planner)

@@ -20,10 +20,16 @@ import yaml
 from pydantic import ValidationError
 
 from emopose import CLASSES
-from emopose.contract import LibraryEntry
+from emopose.contract import MAX_KEYFRAMES, LibraryEntry
 from emopose.joint_limits import JointLimits, LibraryError
+from emopose.robot.g1_spec import NUM_JOINTS
 
 log = logging.getLogger(__name__)
+
+# The largest motion file read: the longest sequence the schema allows (14 keyframes of 14 values), written
+# one full-precision value a line, is under 5 KB; 64 KiB leaves room for comments.
+MAX_FILE_BYTES = 64 * 1024
+
 
 @dataclass(frozen=True)
 class LibrarySnapshot:
@@ -130,9 +136,13 @@ class MotionLibrary:
 
     def _load_file(self, path: Path) -> LibraryEntry:
         try:
-            raw = yaml.safe_load(path.read_text())
-        except (OSError, yaml.YAMLError) as exc:
-            raise LibraryError(f"{path}: not readable YAML ({exc})") from exc
+            size = path.stat().st_size
+            if size > MAX_FILE_BYTES:  # refused before parsing: pure-Python YAML takes minutes on megabytes
+                raise LibraryError(f"{path}: {size} bytes; a motion file is at most {MAX_FILE_BYTES} bytes "
+                                   f"({MAX_KEYFRAMES} keyframes of {NUM_JOINTS} values)")
+            raw = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:  # binary data is not UTF-8 YAML
+            raise LibraryError(f"{path}: not readable YAML ({' '.join(str(exc).split())})") from exc
         entry = self.validate(raw, source=str(path))
         if entry.stroke is None and entry.motion_type == "sequence":
             log.warning("%s: no `stroke: [start, end]`; "

@@ -45,3 +45,14 @@ def test_bad_override_is_a_clear_error_not_a_traceback(tmp_path):
     assert done.returncode == 2
     assert "pipeline.stages.schedule" in done.stderr and "anchor" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+@pytest.mark.parametrize("overrides,named", [
+    (["+experiment=plan", "planner=nope"], "planner=nope: no such option"),  # Hydra's own composition error
+    (["+experiment=plan", "planner=keyword", "utterance=''"], "utterance is empty"),  # its owner refuses
+])
+def test_config_errors_are_one_line_on_stderr_and_exit_2(tmp_path, overrides, named):
+    done = run_cli(tmp_path, *overrides, timeout=120)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and done.stderr.startswith("error: ") and named in done.stderr, \
+        done.stderr

@@ -13,11 +13,13 @@ from dataclasses import dataclass, field
 
 from emopose.bench.confusion import ABBREVIATIONS, ConfusionPanel, confusion_counts, plot_confusion
 from emopose.bench.metrics import accuracy, by_pass, tier_accuracy
-from emopose.bench.suites import TIERS, load_bench
+from emopose.bench.suites import TIERS, BenchItem, load_bench
 from emopose.bench.tables import comparison_markdown, fmt
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
+    check_passes,
     plan_suite,
+    planner_report,
     resolve_passes,
     run_summary,
     suite_output,
@@ -37,14 +39,20 @@ class BenchJob:
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
     confusion: bool = True
 
+    def __post_init__(self) -> None:
+        """The suite is loaded when the job is built: a bad value is a config error before anything starts."""
+        if not self.tiers or set(self.tiers) - set(TIERS):
+            raise ValueError(f"job.tiers={list(self.tiers)}: must be a non-empty subset of {list(TIERS)}")
+        check_passes(self.passes)
+        try:
+            self.items: list[BenchItem] = load_bench(self.path, self.tiers)  # not a field, so no setting
+        except OSError as exc:  # a missing or unreadable bench.path
+            raise ValueError(str(exc)) from exc
+        if not self.items:
+            raise ValueError(f"bench.path={self.path}: no items of tiers {list(self.tiers)}")
+
     def __call__(self, run: Run) -> JobOutput:
-        res = run.resources
-        unknown = sorted(set(self.tiers) - set(TIERS))
-        if unknown:
-            raise ValueError(f"job.tiers has unknown tiers {unknown}; allowed: {list(TIERS)}")
-        items = load_bench(self.path, self.tiers)
-        if not items:
-            raise ValueError(f"{self.path} has no items of tiers {self.tiers} (bench.path)")
+        res, items = run.resources, self.items
         planner, passes = res.planner, resolve_passes(self.passes, res.planner)
         requests = [PlanRequest(utterance=i.text) for i in items]
         predictions, planned_all = [], []
@@ -70,6 +78,7 @@ class BenchJob:
             "per_pass": [{t: accuracy((q["label"], q["pred"]) for q in preds if q["tier"] == t)
                           for t in self.tiers} for preds in by_pass(predictions).values()],
             **run_summary(planned_all, started, self.max_fallback_share),
+            **planner_report(planner),
             "predictions": predictions,
         }
         markdown = comparison_markdown([results]) + "\n" + leading_confusions(predictions, self.tiers)

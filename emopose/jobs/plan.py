@@ -14,9 +14,11 @@ class PlanJob:
     utterance: str
     image: str | None = None
 
-    def __call__(self, run: Run) -> JobOutput:
+    def __post_init__(self) -> None:  # checked when the job is built: a config error, before anything starts
         if not self.utterance.strip():
             raise ValueError("utterance is empty: pass utterance=\"...\"")
+
+    def __call__(self, run: Run) -> JobOutput:
         res = run.resources
         turn = run.runner.run(self.utterance, self.image)
         recorder = run.session.recorder

@@ -18,6 +18,7 @@ from emopose.bench.tables import comparison_markdown
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     PlannedItem,
+    check_passes,
     plan_suite,
     resolve_passes,
     run_summary,
@@ -46,6 +47,9 @@ class SequenceSuiteJob:
     chunk_size: int = 64
     progress: bool = True
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
+
+    def __post_init__(self) -> None:
+        check_passes(self.passes)  # a config error when the job is built, before anything starts
 
     def __call__(self, run: Run) -> JobOutput:
         res = run.resources

@@ -1,7 +1,9 @@
 """Planning a whole suite for the benchmark jobs: passes, chunks, progress, per-item failure isolation.
 
 Requests go through emopose.planners.base.plan_all in chunks (so planners with a concurrent or batched
-`plan_many` keep their speed, and a progress line can advance). If a chunk raises, its items are
+`plan_many` keep their speed). The progress line advances per completed answer for a planner that
+reports them (`reports_progress`: the LLM planners, whose answers take seconds each, so the ETA shows
+from the first answers), per chunk otherwise. If a chunk raises, its items are
 retried one by one, and an item whose planner call raises is recorded as a failure (plan None) while
 the run continues; a PlannerFailure (the planner cannot answer at all) stops the run instead. Every
 answer is parsed with the one contract parser (parse_output), whose Plan.source is each prediction's
@@ -15,7 +17,7 @@ import logging
 import sys
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,13 +60,17 @@ class PlannedItem:
         return None if self.plan is None else tuple(r.cls for r in self.plan.records)
 
 
+def check_passes(passes: int | None) -> None:
+    """`passes` is null or >= 1; a suite job checks it when it is built, before anything starts."""
+    if passes is not None and int(passes) < 1:
+        raise ValueError(f"passes={passes}: must be >= 1 (null: {SAMPLED_PASSES} for a sampled planner, "
+                         f"1 otherwise)")
+
+
 def resolve_passes(passes: int | None, planner: Planner) -> int:
     """`passes` as configured, or by default 5 for a sampled planner (planner.sampled) and 1 otherwise."""
-    if passes is None:
-        return SAMPLED_PASSES if planner.sampled else 1
-    if int(passes) < 1:
-        raise ValueError(f"passes must be >= 1, got {passes}")
-    return int(passes)
+    check_passes(passes)
+    return (SAMPLED_PASSES if planner.sampled else 1) if passes is None else int(passes)
 
 
 def _outcome(output: PlannerOutput, request: PlanRequest) -> PlannedItem:
@@ -72,9 +78,11 @@ def _outcome(output: PlannerOutput, request: PlanRequest) -> PlannedItem:
                        output.meta.get("queue_s"))
 
 
-def _plan_chunk(planner: Planner, chunk: Sequence[PlanRequest]) -> list[PlannedItem]:
+def _plan_chunk(planner: Planner, chunk: Sequence[PlanRequest],
+                on_done: Callable[[], None]) -> list[PlannedItem]:
     try:
-        outputs = plan_all(planner, chunk)
+        outputs = (planner.plan_many(chunk, on_done=on_done) if getattr(planner, "reports_progress", False)
+                   else plan_all(planner, chunk))
         if len(outputs) != len(chunk):
             raise RuntimeError(f"planner returned {len(outputs)} outputs for {len(chunk)} requests")
         return [_outcome(o, r) for o, r in zip(outputs, chunk)]
@@ -94,6 +102,13 @@ def _plan_chunk(planner: Planner, chunk: Sequence[PlanRequest]) -> list[PlannedI
     return items
 
 
+def planner_report(planner: Planner) -> dict:
+    """For results.json: the planner's own account of its run where it keeps one (an LLM planner: model,
+    server, structured output, calls, latency, prompt tokens as the server counted them)."""
+    stats = getattr(planner, "stats", None)
+    return {"planner_stats": stats()} if callable(stats) else {}
+
+
 def plan_suite(planner: Planner, requests: Sequence[PlanRequest], label: str = "planning",
                chunk_size: int = 64, progress: bool = True) -> list[PlannedItem]:
     """Plan every request (in order), showing a progress line on stderr when `progress` is set."""
@@ -104,8 +119,8 @@ def plan_suite(planner: Planner, requests: Sequence[PlanRequest], label: str = "
               mininterval=0.5, unit="item", dynamic_ncols=True) as bar:
         for start in range(0, len(requests), chunk_size):
             chunk = requests[start:start + chunk_size]
-            results.extend(_plan_chunk(planner, chunk))
-            bar.update(len(chunk))
+            results.extend(_plan_chunk(planner, chunk, lambda: bar.update(1)))
+            bar.update(len(results) - bar.n)  # the rest of the chunk (all of it for a chunk-wise planner)
     return results
 
 

@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import pytest
 
 from emopose.bench.suites import SuiteError
+from emopose.build import ConfigError
 from emopose.jobs.bench import BenchJob
 from emopose.planners.base import PlannerFailure, PlannerOutput
 from emopose.planners.baselines.keyword import KeywordPlanner
@@ -86,8 +87,8 @@ def test_malformed_suite_is_refused_with_file_line_field(run_experiment, tmp_pat
     bad = tmp_path / "bench.jsonl"
     good = (FIXTURES / "bench_small.jsonl").read_text().splitlines()
     bad.write_text("\n".join(good[:3] + [good[3].replace('"tier": "easy"', '"tier": "extreme"')]) + "\n")
-    with pytest.raises(SuiteError, match=r"bench.jsonl:4: field 'tier': unknown value 'extreme'"):
-        run_experiment("bench_all", f"bench.path={bad}")
+    with pytest.raises(ConfigError, match=r"bench.jsonl:4: field 'tier': unknown value 'extreme'"):
+        run_experiment("bench_all", f"bench.path={bad}")  # refused when the job is built: one line, exit 2
 
 
 class FlakyPlanner(KeywordPlanner):
