@@ -1,15 +1,18 @@
 """Before any item is planned: can this LLM planner work at all? Each check fails with one line that
 names the cause and the setting to change (LLMConfigError; the CLI exits 2 with it). In order:
 
-1. something accepts a TCP connection at api_base (before litellm's seconds-long import, so a dead
-   local server is named at once);
+1. the server at api_base answers a models listing within planner.client.probe_timeout_s (before
+   litellm's seconds-long import, so a dead or hung local server is named in seconds), which also says
+   whose server it is (emopose/llm/server.py);
 2. the model string routes (litellm knows the provider);
 3. a hosted provider has its API key;
 4. the rendered prompt plus max_tokens fits the context window (planner.client.context_window, else
    litellm's model info; unknown windows are left to the probe);
 5. the probe: one real request with the real system prompt and max_tokens=1, so a rejected key, an
    unknown model or a server-side context overflow is found in seconds, before any item could
-   silently fall back to the keyword rules.
+   silently fall back to the keyword rules. It offers the structured-output forms the planner asks
+   for, best first (emopose/llm/formats.py): a form the server refuses is noted in one line and the
+   next is tried; the probe's `usage` gives the prompt's size as the server counts it.
 
 planner.client.probe=false skips 1 and 5 (replaying a benchmark from the response cache with the
 server off). The settings named are the planner's `client:` node (conf/llm/).
@@ -17,25 +20,29 @@ server off). The settings named are the planner's `client:` node (conf/llm/).
 
 from __future__ import annotations
 
-import socket
+import itertools
+import logging
 import time
-from urllib.parse import urlsplit
+from collections.abc import Callable
 
-from emopose.llm.client import LLMClient
-from emopose.llm.errors import LLMConfigError, backoff_delay, cause, is_transient, litellm_module
+from emopose.llm.client import LLMClient, usage_prompt_tokens
+from emopose.llm.errors import (
+    LLMConfigError,
+    backoff_delay,
+    cause,
+    is_transient,
+    litellm_module,
+    refuses_format,
+)
+from emopose.llm.server import Endpoint, identify
+
+log = logging.getLogger(__name__)
+
+FormatOffer = Callable[[Endpoint], list[tuple[str, dict | None]]]  # (form name, response_format), best first
 
 
-def check_listening(api_base: str | None, timeout_s: float = 3.0) -> None:
-    """Something accepts connections at api_base (a hosted provider's endpoint is left to the probe)."""
-    if not api_base:
-        return
-    url = urlsplit(api_base if "://" in api_base else f"http://{api_base}")
-    port = url.port or (443 if url.scheme == "https" else 80)
-    try:
-        socket.create_connection((url.hostname or "127.0.0.1", port), timeout=timeout_s).close()
-    except OSError as exc:
-        raise LLMConfigError(f"nothing answers at {api_base} ({exc.strerror or exc}): start the server or "
-                             "fix planner.client.api_base") from exc
+class FormatRefused(LLMConfigError):
+    """The server rejected the probe's response_format (the next form may do)."""
 
 
 def check_route(client: LLMClient) -> None:
@@ -89,30 +96,61 @@ def check_context(client: LLMClient, messages: list[dict]) -> None:
             "planner.client.max_tokens, or raise the server's context (and planner.client.context_window)")
 
 
-def probe(client: LLMClient, messages: list[dict], response_format: dict | None, retries: int = 1) -> None:
-    """One real request (max_tokens=1, no cache, not counted); a transient error is retried `retries`
-    times."""
+def probe(client: LLMClient, messages: list[dict], response_format: dict | None, retries: int = 1):
+    """One real request (max_tokens=1, no cache, not counted) and its response; a transient error is
+    retried `retries` times; FormatRefused when the server rejects `response_format`."""
     kwargs = client.call_kwargs(messages, response_format, max_tokens=1)
-    for attempt in range(retries + 1):
+    for attempt in itertools.count():
         try:
-            litellm_module().completion(**kwargs)
-            return
+            return client.within_deadline(lambda: litellm_module().completion(**kwargs))
         except Exception as exc:  # noqa: BLE001 - sorted below
+            first = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
+            if response_format and refuses_format(exc):
+                raise FormatRefused(first) from exc
             reason = cause(exc, client.model, client.api_base)
             if reason is None and is_transient(exc) and attempt < retries:
                 time.sleep(backoff_delay(attempt, client.backoff_s, client.backoff_max_s, exc))
                 continue
-            first = str(exc).splitlines()[0][:200] if str(exc) else type(exc).__name__
             raise LLMConfigError(f"planner probe of {client.model} failed: "
                                  f"{reason or f'{type(exc).__name__}: {first}'}") from exc
 
 
-def check_client(client: LLMClient, messages: list[dict], response_format: dict | None) -> None:
-    """The checks above in order, for a request like `messages`; raise LLMConfigError naming the cause."""
+def probe_formats(client: LLMClient, messages: list[dict], server: Endpoint, offers: FormatOffer) -> Endpoint:
+    """Probe with each offered form until the server takes one; the server, that form and the notes."""
+    offered, notes = offers(server), []
+    for k, (form, response_format) in enumerate(offered):
+        try:
+            response = probe(client, messages, response_format)
+        except FormatRefused as refused:
+            following = offered[k + 1][0] if k + 1 < len(offered) else None
+            notes.append(f"{server.kind} at {client.api_base or 'the provider'} refused structured output "
+                         f"{form} ({str(refused)[:120]}); "
+                         + (f"using {following}" if following else "nothing left to try"))
+            log.warning("planner: %s", notes[-1])
+            continue
+        return Endpoint(server.kind, server.api_base, server.models, form, tuple(notes),
+                        usage_prompt_tokens(response))
+    tried = ", ".join(form for form, _ in offered)
+    raise LLMConfigError(f"{server.kind} at {client.api_base or 'the provider'} refused every structured "
+                         f"output tried ({tried}): set planner.structured_output=auto (tries what the server "
+                         "takes) or planner.structured_output=none (the prompt alone asks for JSON)")
+
+
+def check_client(client: LLMClient, messages: list[dict], offers: FormatOffer) -> Endpoint:
+    """The checks above in order, for a request like `messages`; raise LLMConfigError naming the cause.
+    Returns what was found: the server, the structured-output form it takes, the prompt's size."""
+    server = identify(client.api_base, client.api_key, client.probe_timeout_s) if client.probe \
+        else Endpoint("unchecked", client.api_base)
     if client.probe:
-        check_listening(client.api_base)
+        log.info("planner: %s at %s%s; probing %s", server.kind, client.api_base or "the provider's endpoint",
+                 f" serving {', '.join(server.models)}" if server.models else "", client.model)
     check_route(client)
     check_key(client)
     check_context(client, messages)
-    if client.probe:
-        probe(client, messages, response_format)
+    if not client.probe:
+        form = offers(server)[0][0]
+        return Endpoint(server.kind, server.api_base, structured_output=form)
+    found = probe_formats(client, messages, server, offers)
+    log.info("planner: structured output %s; prompt %s tokens (the server's count)", found.structured_output,
+             found.probe_prompt_tokens if found.probe_prompt_tokens is not None else "not reported")
+    return found

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 from emopose.llm.cache import ResponseCache, cache_key
 from emopose.llm.counters import CallCounters
+from emopose.llm.deadline import await_within, call_within, clean_text
 from emopose.llm.errors import LLMCallError, LLMConfigError, backoff_delay, cause, is_transient
 from emopose.llm.errors import litellm_module as _litellm
 
@@ -31,6 +32,12 @@ def effective_api_key(litellm, model: str, api_base: str | None, api_key: str | 
         return api_key
     keys_in_environment = litellm.validate_environment(model=model).get("keys_in_environment")
     return None if keys_in_environment else NO_KEY_PLACEHOLDER
+
+
+def usage_prompt_tokens(response) -> int | None:
+    """The prompt's size as the server counted it (the response's `usage`), None when it sent none."""
+    tokens = getattr(getattr(response, "usage", None), "prompt_tokens", None)
+    return int(tokens) if isinstance(tokens, int) else None
 
 
 @dataclass(frozen=True)
@@ -48,8 +55,10 @@ class LLMClient:
 
     Built from the planner's `client:` node (conf/llm/). Besides the call itself it holds what a run needs
     to know about the endpoint: `concurrency` (requests on the wire at once in a batch), `context_window`
-    (tokens; None: litellm's model info), `probe` (check() sends one real request), `abort_after`
-    (unmendable failures in a row that stop a run) and `pass_index` (the draw while sampling)."""
+    (tokens; None: litellm's model info), `probe` (check() sends one real request), `probe_timeout_s`
+    (the most check() waits for the server to list its models), `abort_after` (unmendable failures in a
+    row that stop a run) and `pass_index` (the draw while sampling). `timeout_s` is a hard deadline on
+    each attempt, body included (emopose/llm/deadline.py)."""
 
     def __init__(self, model: str = "openai/gpt-4o-mini", api_base: str | None = None,
                  api_key: str | None = None, temperature: float = 0.7, max_tokens: int | None = 1024,
@@ -57,11 +66,12 @@ class LLMClient:
                  backoff_max_s: float = 30.0, concurrency: int = 16, cache: bool = True,
                  cache_dir: str = "~/.cache/emopose/llm", pass_index: int = 0,
                  extra_params: dict | None = None, context_window: int | None = None, probe: bool = True,
-                 abort_after: int = 5) -> None:
+                 abort_after: int = 5, probe_timeout_s: float = 5.0) -> None:
         if not isinstance(model, str) or not model.strip():
             raise LLMConfigError("planner.client.model is empty; give a litellm model string such as "
                                  "openai/gpt-4o-mini")
         for key, value, low in (("temperature", temperature, 0), ("timeout_s", timeout_s, 1e-3),
+                                ("probe_timeout_s", probe_timeout_s, 1e-3),
                                 ("max_retries", max_retries, 0), ("backoff_s", backoff_s, 0),
                                 ("concurrency", concurrency, 1), ("abort_after", abort_after, 1),
                                 ("context_window", context_window, 1)):
@@ -74,6 +84,7 @@ class LLMClient:
         self.concurrency, self.abort_after = int(concurrency), int(abort_after)
         self.pass_index = int(pass_index)  # a suite job may set it before each pass
         self.context_window, self.probe = context_window, bool(probe)
+        self.probe_timeout_s = float(probe_timeout_s)
         self.cache = ResponseCache(cache_dir) if cache else None
         self.counters = CallCounters()
         self._key_resolved: tuple[str | None] | None = None  # decided on the first call (needs litellm)
@@ -123,6 +134,10 @@ class LLMClient:
             kwargs["api_key"] = api_key
         return {**kwargs, **overrides}
 
+    def within_deadline(self, call):
+        """call() (one blocking litellm request), or CallTimeout once timeout_s has passed."""
+        return call_within(call, self.timeout_s)
+
     def _effective_key(self) -> str | None:
         if self._key_resolved is None:  # asked once: validate_environment reads the environment
             self._key_resolved = (effective_api_key(_litellm(), self.model, self.api_base, self.api_key),)
@@ -168,7 +183,8 @@ class LLMClient:
         latency = time.perf_counter() - started
         self.counters.latency(latency, queued_s)
         choice = response.choices[0]
-        text = choice.message.content or ""
+        text = clean_text(choice.message.content or "")
+        self.counters.prompt(usage_prompt_tokens(response))
         if self.cache and key and text.strip():  # an empty answer is usually a provider hiccup: ask again
             self.cache.put(key, text, {"model": self.model, "finish_reason": choice.finish_reason})
         return Completion(text, attempts, cached=False, finish_reason=choice.finish_reason,
@@ -184,7 +200,7 @@ class LLMClient:
         kwargs, started = self.call_kwargs(messages, response_format), time.perf_counter()
         for attempt in itertools.count():
             try:
-                response = _litellm().completion(**kwargs)
+                response = self.within_deadline(lambda: _litellm().completion(**kwargs))
             except Exception as exc:  # noqa: BLE001 - litellm raises many types; is_transient sorts them
                 time.sleep(self._retry_delay(exc, attempt, started))
                 continue
@@ -197,7 +213,7 @@ class LLMClient:
         kwargs, started = self.call_kwargs(messages, stream=True), time.perf_counter()
         for attempt in itertools.count():
             try:
-                return _litellm().completion(**kwargs), attempt + 1
+                return self.within_deadline(lambda: _litellm().completion(**kwargs)), attempt + 1
             except Exception as exc:  # noqa: BLE001 - as in complete()
                 time.sleep(self._retry_delay(exc, attempt, started))
 
@@ -218,7 +234,7 @@ class LLMClient:
                 queued_s += waited
                 started = time.perf_counter() if started is None else started + waited
                 try:
-                    response = await _litellm().acompletion(**kwargs)
+                    response = await await_within(_litellm().acompletion(**kwargs), self.timeout_s)
                 except Exception as exc:  # noqa: BLE001 - as in complete()
                     delay = self._retry_delay(exc, attempt, started, queued_s)
                 else:

@@ -11,9 +11,11 @@ from __future__ import annotations
 import contextlib
 import logging
 import random
+import re
 import socket
 
 TRANSIENT_STATUS = frozenset({408, 409, 429})
+_FORMAT_WORDS = re.compile(r"response_format|json_schema|json_object", re.IGNORECASE)
 
 
 class LLMConfigError(ValueError):
@@ -51,10 +53,17 @@ def unreachable(exc: BaseException) -> bool:
 
 def is_transient(exc: BaseException) -> bool:
     litellm = litellm_module()
-    if isinstance(exc, (litellm.Timeout, litellm.APIConnectionError)) or unreachable(exc):
+    if isinstance(exc, (litellm.Timeout, litellm.APIConnectionError, TimeoutError)) or unreachable(exc):
         return True
     status = getattr(exc, "status_code", None)
     return isinstance(status, int) and (status in TRANSIENT_STATUS or status >= 500)
+
+
+def refuses_format(exc: BaseException) -> bool:
+    """The server rejected the request's response_format (llama-cpp-python answers HTTP 500 naming the
+    field, OpenAI-style servers 400/422): the planner then tries the next form the server may take."""
+    status = getattr(exc, "status_code", None)
+    return status in (400, 422, 500) and bool(_FORMAT_WORDS.search(str(exc)))
 
 
 def cause(exc: BaseException, model: str, api_base: str | None) -> str | None:

@@ -130,3 +130,21 @@ def faulty(delay_s: float, bad_rate: float, seed: int = 0, mix: tuple[str, ...] 
         return chosen
 
     return answer
+
+
+def prompt_tokens(body: dict) -> int:
+    """A server-side token estimate (4 characters a token), as a context-window check would make."""
+    return len(json.dumps(body.get("messages", []))) // 4
+
+
+def context_overflow(window: int) -> Callable[[dict], Answer | None]:
+    """A gate: a request whose prompt + max_tokens exceeds `window` gets OpenAI's context-length 400."""
+
+    def gate(body: dict) -> Answer | None:
+        wanted = prompt_tokens(body) + int(body.get("max_tokens") or 0)
+        if wanted <= window:
+            return None
+        return http_error(400, f"This model's maximum context length is {window} tokens. However, you "
+                               f"requested {wanted} tokens. Please reduce the length of the messages.")
+
+    return gate

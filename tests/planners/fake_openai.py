@@ -5,7 +5,9 @@ hosted provider (api_base = server.url), so nothing inside litellm is mocked. An
 FIFO script first, then from `default` (an Answer, or a callable (body, index) -> Answer). Every
 request body is recorded for assertions, and two counters stand in for wall-clock bounds: `peak`
 (the most requests in progress at once: concurrency) and `answered` (answers sent so far; one still
-sitting out its delay is not, so a client that returned before it has timed out). A request with
+sitting out its delay is not, so a client that returned before it has timed out). `usage` carries
+the server's prompt-size estimate (fake_answers.prompt_tokens); `listing`, when set, answers GET
+/v1/models (fake_llama_cpp.py: whose server it is). A request with
 "stream": true gets server-sent events (fake_stream.py: paced tokens, a held or dying stream);
 `tokens_sent` and `streams_dropped` (streams the client closed early) count them.
 
@@ -29,7 +31,7 @@ from collections.abc import Callable
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Self
 
-from fake_answers import FAULTS, PLAN_JSON, Answer, faulty, http_error, ok
+from fake_answers import FAULTS, PLAN_JSON, Answer, context_overflow, faulty, http_error, ok, prompt_tokens
 from fake_stream import generation_s, send_stream, streamed
 
 __all__ = ["PLAN_JSON", "Answer", "FakeOpenAI"]
@@ -37,36 +39,19 @@ __all__ = ["PLAN_JSON", "Answer", "FakeOpenAI"]
 CHAT_PATHS = ("/v1/chat/completions", "/chat/completions")
 
 
-def _completion_body(answer: Answer, model: str) -> dict:
+def _completion_body(answer: Answer, body: dict) -> dict:
+    model, tokens = body.get("model", ""), prompt_tokens(body)
     return {
         "id": "chatcmpl-fake", "object": "chat.completion", "created": int(time.time()), "model": model,
         "choices": [{"index": 0, "finish_reason": answer.finish_reason,
                      "message": {"role": "assistant", "content": answer.content}}],
-        "usage": {"prompt_tokens": 10, "completion_tokens": 10, "total_tokens": 20},
+        "usage": {"prompt_tokens": tokens, "completion_tokens": 10, "total_tokens": tokens + 10},
     }
 
 
 def _error_body(status: int, message: str | None = None) -> dict:
     kind = {429: "rate_limit_exceeded", 401: "invalid_api_key"}.get(status, "server_error")
     return {"error": {"message": message or f"scripted HTTP {status}", "type": kind, "code": kind}}
-
-
-def prompt_tokens(body: dict) -> int:
-    """A server-side token estimate (4 characters a token), as a context-window check would make."""
-    return len(json.dumps(body.get("messages", []))) // 4
-
-
-def context_overflow(window: int) -> Callable[[dict], Answer | None]:
-    """A gate: a request whose prompt + max_tokens exceeds `window` gets OpenAI's context-length 400."""
-
-    def gate(body: dict) -> Answer | None:
-        wanted = prompt_tokens(body) + int(body.get("max_tokens") or 0)
-        if wanted <= window:
-            return None
-        return http_error(400, f"This model's maximum context length is {window} tokens. However, you "
-                               f"requested {wanted} tokens. Please reduce the length of the messages.")
-
-    return gate
 
 
 class FakeOpenAI:
@@ -79,6 +64,7 @@ class FakeOpenAI:
         self.default = default or ok()
         self.api_key, self.models = api_key, models
         self.gate = context_overflow(context_window) if context_window else None
+        self.listing: dict | None = None  # GET /v1/models answers it (None: 404, as many servers do)
         self.requests: list[dict] = []
         self.paths: list[str] = []
         self.served: Counter[str] = Counter()  # answer kinds sent, e.g. {"ok": 9, "http_500": 1}
@@ -161,6 +147,7 @@ class FakeOpenAI:
         with self._lock:
             return {"requests": len(self.requests), "served": dict(self.served)}
 
+
 class _Handler(BaseHTTPRequestHandler):
     """One connection to `fake` (the FakeOpenAI whose server made it)."""
 
@@ -178,6 +165,8 @@ class _Handler(BaseHTTPRequestHandler):
     def do_GET(self) -> None:
         if self.path == "/stats":  # for a server in another process (the load benchmark)
             self._send(200, self.fake.stats())
+        elif self.path.split("?")[0] in ("/v1/models", "/models") and self.fake.listing is not None:
+            self._send(200, self.fake.listing)
         else:
             self._send(404, {"error": {"message": f"no route {self.path}"}})
 
@@ -201,7 +190,7 @@ class _Handler(BaseHTTPRequestHandler):
         elif body.get("stream"):
             sent = send_stream(self, answer, body.get("model", ""), self.fake)
         else:
-            sent = self._send(200, _completion_body(answer, body.get("model", "")), answer.headers)
+            sent = self._send(200, _completion_body(answer, body), answer.headers)
         self.fake._done(sent)
 
     def _send(self, status: int, payload: dict, headers: dict | None = None) -> bool:

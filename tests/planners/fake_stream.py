@@ -37,6 +37,13 @@ def streamed(text: str, first_token_s: float = 0.0, tokens_per_s: float = 0.0, d
                         die_after=die_after, hold=hold, hold_after=hold_after)
 
 
+def runaway(sentences: int = 60, tokens_per_s: float = 200.0) -> StreamAnswer:
+    """A model that will not stop talking: `sentences` sentences (about 3 s of speech each), paced so a
+    client that closes early is seen doing it (streams_dropped) before the server has sent it all."""
+    text = " ".join(f"This is sentence number {k} of a reply that goes on and on." for k in range(sentences))
+    return streamed(text, tokens_per_s=tokens_per_s)
+
+
 def generation_s(answer: Answer) -> float:
     """How long the whole answer takes to write: what an unstreamed request waits before its reply."""
     if not isinstance(answer, StreamAnswer) or not answer.tokens_per_s:

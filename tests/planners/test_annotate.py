@@ -89,3 +89,29 @@ def test_the_preset_composes_with_the_local_annotator_and_the_hosted_client(comp
     assert planner.mode == "respond" and planner.template.endswith("prompts/annotate.md")
     assert planner.client._target_ == "emopose.llm.client.LLMClient"
     assert planner.client.max_tokens == 256  # a few spoken sentences; the rest as conf/llm/hosted.yaml
+
+
+def test_the_prompt_states_the_bound_and_a_long_reply_ends_at_a_sentence_boundary(fake_openai, make_annotate):
+    long_reply = " ".join(f"Sentence {k} is about the lab and what we do in it every day." for k in range(18))
+    fake_openai.default = ok(long_reply + "\x07")
+    planner = make_annotate(max_sentences=2, max_speech_s=30)
+    plan = parse_output(planner.plan(QUESTION), QUESTION.utterance)
+    assert plan.reply == "Sentence 0 is about the lab and what we do in it every day. " \
+                         "Sentence 1 is about the lab and what we do in it every day."
+    system = fake_openai.requests[0]["messages"][0]["content"]
+    assert "at most 2 short sentences, no more than 30 seconds of speech" in system
+
+
+def test_the_speech_bound_and_the_reply_length_cut_at_sentence_boundaries(fake_openai, make_annotate):
+    sentence = "This sentence has exactly ten words in it, you see."  # about 3.6 s at 165 words a minute
+    fake_openai.default = ok(" ".join([sentence] * 8))
+    by_speech = parse_output(make_annotate(max_sentences=8, max_speech_s=8).plan(QUESTION)).reply
+    assert by_speech == " ".join([sentence] * 2)
+    by_length = parse_output(make_annotate(max_sentences=8, max_speech_s=60).plan(QUESTION)).reply
+    assert by_length == " ".join([sentence] * 3)  # four would pass the contract's 200 characters
+
+
+@pytest.mark.parametrize("setting", [{"max_sentences": 0}, {"max_speech_s": 0}])
+def test_a_bound_below_one_sentence_is_refused(make_annotate, setting):
+    with pytest.raises(ValueError, match=f"planner.{next(iter(setting))} = 0 must be"):
+        make_annotate(**setting)

@@ -8,7 +8,7 @@ import time
 
 import pytest
 from fake_answers import http_error
-from fake_stream import streamed, tokens
+from fake_stream import runaway, streamed, tokens
 
 from emopose.execution.sequencer import State
 from emopose.planners.baselines.keyword import KeywordPlanner
@@ -26,7 +26,7 @@ FIRST = len(tokens(SENTENCES[0])) + 1  # the next token's leading space shows th
 @pytest.fixture
 def wired(writable_library, make_chat, tmp_path):
     planner = make_chat(AnnotatePlanner, "prompts/annotate.md", annotator=KeywordPlanner(), stream=True,
-                        cache=False, max_retries=0)
+                        cache=False, max_retries=0, max_sentences=len(SENTENCES))
     built = wire(writable_library, tmp_path / "run", planner=planner, mode="timeline")
     with built.session:
         yield built
@@ -117,3 +117,17 @@ def test_a_stream_refused_before_its_first_sentence_falls_back_as_an_unstreamed_
 def test_the_preset_streams_on_request(compose):
     planner = compose("planner=annotate", "planner.stream=true").planner
     assert planner.stream is True and planner.stream_preroll_s == 0.0
+
+
+def test_a_runaway_reply_ends_at_its_bound_and_the_stream_is_closed(fake_openai, wired):
+    fake_openai.default = runaway(sentences=60)  # about three minutes of speech if let run
+    bound = wired.runner.planner.bound
+    bound.max_sentences, bound.max_speech_s = 3, 60.0  # planner.max_sentences, planner.max_speech_s
+    reply = wired.runner.run_streamed("Tell me about the lab.")
+    said = [t.plan.reply for t in reply.turns]
+    assert said == [f"This is sentence number {k} of a reply that goes on and on." for k in range(3)]
+    for _ in range(500):  # the server finds out at its next write but one
+        if fake_openai.streams_dropped:
+            break
+        time.sleep(0.01)
+    assert fake_openai.streams_dropped == 1 and fake_openai.tokens_sent < len(tokens(runaway(60).content))

@@ -47,13 +47,20 @@ def test_json_schema_carries_the_live_variants(fake_openai, make_llm_planner, wr
     assert "comforting_hug" in _record_schema(_sent(fake_openai))["properties"]["variant"]["enum"]
 
 
-def test_auto_follows_what_litellm_reports(fake_openai, make_llm_planner):
-    make_llm_planner(model="openai/gpt-4o-mini").plan(LINE)  # litellm: supports response schemas
+def test_unprobed_auto_asks_litellm_for_a_hosted_model_and_sends_json_schema_to_a_server(fake_openai,
+                                                                                        make_llm_planner):
+    make_llm_planner(model="openai/fake-model").plan(LINE)  # a server at api_base, no check() ran
     assert _sent(fake_openai)["type"] == "json_schema"
-    make_llm_planner(model="openai/fake-model").plan(LINE)  # no model card: the provider takes json_object
-    assert _sent(fake_openai) == {"type": "json_object"}
+    assert make_llm_planner(model="openai/gpt-4o-mini", api_base=None).structured_output == "json_schema"
+    assert make_llm_planner(model="openai/fake-model", api_base=None).structured_output == "json_object"
     make_llm_planner(structured_output="none").plan(LINE)  # prompt only
     assert _sent(fake_openai) is None
+
+
+def test_json_object_schema_is_llama_cpp_pythons_form(fake_openai, make_llm_planner):
+    planner = make_llm_planner(structured_output="json_object_schema")
+    planner.plan(LINE)
+    assert _sent(fake_openai) == {"type": "json_object", "schema": planner.answer_schema()}
 
 
 def test_the_format_is_part_of_the_cache_key(fake_openai, make_llm_planner):

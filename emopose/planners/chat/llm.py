@@ -7,11 +7,14 @@ placeholder: ${library_guide} (a line per motion, prompts/structured.md) or ${li
 per class, prompts/compact.md for small local models).
 
 Structured output (planner.structured_output): the answer's JSON schema (emopose.contract.plan_schema,
-the eight classes and the live variant names as enums) goes out as response_format where litellm
-reports the model supports schemas; {"type": "json_object"} where it supports only that; nothing
-(prompt only) otherwise. "auto" asks litellm; json_schema | json_object | none force a choice (a
-llama.cpp or vLLM server takes json_schema though litellm has no card for it). The answer is returned
-untouched as raw contract JSON: validating it is the parse stage's job, the one edge for model output.
+the eight classes and the live variant names as enums) goes out as response_format in the form the
+server takes (emopose/llm/formats.py: json_schema, json_object_schema for llama-cpp-python, json_object,
+none). check() identifies the server and probes the forms best first, noting each refused one; the
+form found is used for every item and named in the planner's stats (results.json). Without a probe
+(planner.client.probe=false, or plan() before check()) "auto" is what litellm reports for a hosted
+model and json_schema for a server at api_base.
+The answer is returned untouched as raw contract JSON: validating it is the parse stage's job, the one
+edge for model output.
 """
 
 from __future__ import annotations
@@ -20,12 +23,13 @@ from emopose.contract import plan_schema
 from emopose.library import MotionLibrary
 from emopose.llm.client import LLMClient
 from emopose.llm.errors import litellm_module
+from emopose.llm.formats import SERVER_FORMS, SETTINGS, candidates, response_format
+from emopose.llm.server import Endpoint
 from emopose.planners.base import ModalPlanner, PlannerMode
 from emopose.planners.chat.guide import library_guide
 from emopose.planners.chat.planner import ChatPlanner
 from emopose.planners.chat.prompting import PromptError, plan_demonstrations
 
-STRUCTURED = ("auto", "json_schema", "json_object", "none")
 GUIDES = {"library_guide": "full", "library_names": "short"}  # placeholder -> guide form
 
 
@@ -55,8 +59,8 @@ class LLMPlanner(ChatPlanner, ModalPlanner):
         super().__init__(client, template, demonstrations, max_demonstrations)
         if not 1 <= max_gestures <= 8:
             raise ValueError(f"planner.max_gestures = {max_gestures} must be in 1..8")
-        if structured_output not in STRUCTURED:
-            raise ValueError(f"planner.structured_output = {structured_output!r}; choose one of {STRUCTURED}")
+        if structured_output not in SETTINGS:
+            raise ValueError(f"planner.structured_output = {structured_output!r}; choose one of {SETTINGS}")
         self.library, self.mode, self.max_gestures = library, PlannerMode.parse(mode), int(max_gestures)
         self.narrates = self.mode is PlannerMode.NARRATE
         self.template.require("demonstrations",
@@ -66,7 +70,7 @@ class LLMPlanner(ChatPlanner, ModalPlanner):
             raise PromptError(f"{self.template.path}: planner=llm needs ${{library_guide}} or "
                               "${library_names}")
         self._examples = plan_demonstrations(self.demonstrations, self.mode)
-        self._structured = structured_output
+        self._setting, self._unchecked_form = structured_output, None
         self._schema: tuple[int, dict] | None = None  # (library version, schema)
         self.system_prompt()  # render once now, so a template error surfaces at build time
 
@@ -80,19 +84,25 @@ class LLMPlanner(ChatPlanner, ModalPlanner):
 
     @property
     def structured_output(self) -> str:
-        """The form actually sent (auto resolved through litellm on first use)."""
-        if self._structured == "auto":
-            self._structured = supported_structured_output(self.client.model)
-        return self._structured
+        """The form sent: what check() found the server takes; unprobed, the setting (auto: what litellm
+        reports for a hosted model, json_schema for a server at api_base)."""
+        if self.endpoint is not None and self.endpoint.structured_output:
+            return self.endpoint.structured_output
+        if self._unchecked_form is None:
+            self._unchecked_form = self.format_offers(Endpoint("unchecked"))[0][0]
+        return self._unchecked_form
+
+    def format_offers(self, server: Endpoint) -> list[tuple[str, dict | None]]:
+        kind = "openai-compatible" if server.kind == "unchecked" and self.client.api_base else server.kind
+        asks_litellm = self._setting == "auto" and kind not in SERVER_FORMS
+        reported = supported_structured_output(self.client.model) if asks_litellm else "none"
+        return [(form, self._format(form)) for form in candidates(self._setting, kind, reported)]
 
     def response_format(self) -> dict | None:
-        form = self.structured_output
-        if form == "none":
-            return None
-        if form == "json_object":
-            return {"type": "json_object"}
-        return {"type": "json_schema", "json_schema": {"name": "gesture_plan", "strict": True,
-                                                       "schema": self.answer_schema()}}
+        return self._format(self.structured_output)
+
+    def _format(self, form: str) -> dict | None:
+        return response_format(form, self.answer_schema()) if form != "none" else None
 
     def answer_schema(self) -> dict:
         """plan_schema for the library's current version (rebuilt when a motion is saved)."""

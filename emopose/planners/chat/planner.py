@@ -26,13 +26,14 @@ import json
 import logging
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Coroutine, Sequence
+from collections.abc import Callable, Coroutine, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from emopose.llm.check import check_client
 from emopose.llm.client import Completion, LLMClient
 from emopose.llm.counters import CallCounters
+from emopose.llm.server import Endpoint
 from emopose.planners.base import BatchPlanner, CheckedPlanner, PlannerFailure, PlannerOutput, PlanRequest
 from emopose.planners.baselines.keyword import keyword_records
 from emopose.planners.chat.prompting import (
@@ -63,6 +64,7 @@ class ChatPlanner(CheckedPlanner, BatchPlanner, ABC):
 
     name = "chat"
     narrates = True  # the utterance is the robot's own line (see PlannerOutput.line)
+    reports_progress = True  # plan_many(requests, on_done) calls on_done() as each answer comes
 
     def __init__(self, client: LLMClient, template: str, demonstrations: str,
                  max_demonstrations: int | None = None) -> None:
@@ -71,6 +73,7 @@ class ChatPlanner(CheckedPlanner, BatchPlanner, ABC):
         self.client = client
         self.template = PromptTemplate.load(template)
         self.demonstrations: list[Demonstration] = load_demonstrations(demonstrations)[:max_demonstrations]
+        self.endpoint: Endpoint | None = None  # what check() found: server, structured output, prompt size
 
     # -- what subclasses define ------------------------------------------------------------------
     @abstractmethod
@@ -84,18 +87,24 @@ class ChatPlanner(CheckedPlanner, BatchPlanner, ABC):
     def to_contract(self, text: str, request: PlanRequest) -> str:
         return text
 
+    def format_offers(self, server: Endpoint) -> list[tuple[str, dict | None]]:
+        """The structured-output forms check() may probe on `server`, best first: (name, response_format)."""
+        return [("none", None)]
+
     # -- shared behaviour ------------------------------------------------------------------------
     @property
     def sampled(self) -> bool:
         return self.client.sampled
 
     def check(self) -> None:
-        """Raise LLMConfigError when the model cannot work (see emopose/llm/check.py)."""
-        check_client(self.client, self.messages(PlanRequest(PROBE_LINE)), self.response_format())
+        """Raise LLMConfigError when the model cannot work (see emopose/llm/check.py); keep what it found."""
+        self.endpoint = check_client(self.client, self.messages(PlanRequest(PROBE_LINE)), self.format_offers)
 
     def stats(self) -> dict:
-        """calls, cache_hits, retries, failed_calls, and model-call latency and queueing mean / p95 (s)."""
-        return {"planner": self.name, "model": self.client.model, **self.client.counters.stats()}
+        """The model and the server it ran on (kind, served models, structured output, notes), calls,
+        cache_hits, retries, failed_calls, model-call latency and queueing mean / p95 (s), prompt tokens."""
+        endpoint = (self.endpoint or Endpoint("unchecked", self.client.api_base)).summary()
+        return {"planner": self.name, "model": self.client.model, **endpoint, **self.client.counters.stats()}
 
     def reset_stats(self) -> None:
         """Start the counters afresh (e.g. after a warm-up call, or between a job's conditions)."""
@@ -124,12 +133,20 @@ class ChatPlanner(CheckedPlanner, BatchPlanner, ABC):
             return self._fallback(request, exc, pass_index, getattr(exc, "latency_s", 0.0))
         return self._output(request, raw, completion.latency_s, completion, pass_index)
 
-    def plan_many(self, requests: Sequence[PlanRequest]) -> list[PlannerOutput]:
-        """All requests concurrently (at most client.concurrency on the wire), answers in request order."""
+    def plan_many(self, requests: Sequence[PlanRequest],
+                  on_done: Callable[[], None] | None = None) -> list[PlannerOutput]:
+        """All requests concurrently (at most client.concurrency on the wire), answers in request order;
+        on_done() after each answer (a progress line)."""
+
+        async def one(request: PlanRequest, gate: asyncio.Semaphore) -> PlannerOutput:
+            output = await self.aplan(request, gate)
+            if on_done is not None:
+                on_done()
+            return output
 
         async def run() -> list[PlannerOutput]:
             gate = asyncio.Semaphore(self.client.concurrency)
-            return list(await asyncio.gather(*(self.aplan(r, gate) for r in requests)))
+            return list(await asyncio.gather(*(one(r, gate) for r in requests)))
 
         return run_coroutine(run()) if requests else []
 
