@@ -10,6 +10,8 @@ and reads its session.mcap and results.json:
   loop          missed deadlines / ticks, stalls, lateness (results.json) and the largest gap between
                 two recorded commands (/joints/command)
   latency       request -> speech start and request -> first executed stroke, median and p95
+  joints        the simulated joints (/joints/sim) against the hard limits and the speed bounds
+                (emopose.sync.joint_bounds)
 Server and benchmark share the machine's monotonic clock (time.perf_counter), so request times and the
 server's clock times compare directly.
 Run: python benchmarks/live_serve.py [--items 320] [--busy 1] [--pages 0] [--extra key=value ...]
@@ -25,7 +27,6 @@ import signal
 import socket
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import urllib.request
@@ -36,11 +37,17 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
+from emopose.joint_limits import JointLimits
 from emopose.recording import read_recording
+from emopose.sync.joint_bounds import joint_bounds
 from emopose.sync.recording import read_stroke_sync
 from emopose.sync.strokes import stroke_summary
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run_dirs import measure_and_print  # noqa: E402
+
 SUITE = ROOT / "experiments" / "sequence" / "sequence_suite.jsonl"
+LIMITS = ROOT / "library" / "g1" / "limits.yaml"  # the default library set's (serve's default)
 BUSY_LOOP = "while True:\n    pass\n"
 
 
@@ -141,6 +148,13 @@ def command_gaps(mcap: Path) -> dict:
             "gaps_over_60ms": int(np.sum(gaps > 60))}
 
 
+def simulated_joint_bounds(mcap: Path) -> dict:
+    rows = read_recording(mcap).get("/joints/sim", [])
+    times = np.array([m["t"] for _, m in rows])
+    q = np.array([m["q"] for _, m in rows])
+    return joint_bounds(times, q, JointLimits.from_file(LIMITS))
+
+
 def serve_command(port: int, run_dir: Path, extra: list[str]) -> list[str]:
     return [sys.executable, "-m", "emopose", "+experiment=serve", "backend=mujoco", "tts=espeak",
             "player=none", f"serve.port={port}", f"hydra.run.dir={run_dir}", *extra]
@@ -176,7 +190,8 @@ def measure(args: argparse.Namespace, run_dir: Path) -> dict:
             "busy": args.busy, "pages": args.pages, "driven_s": round(driven_s, 1),
             "strokes_commands": stroke_summary(rows),
             "strokes_simulated": stroke_summary(rows, simulated=True),
-            "loop": {**loop, **command_gaps(run_dir / "session.mcap")}, **latencies(turns)}
+            "loop": {**loop, **command_gaps(run_dir / "session.mcap")},
+            "simulated_joints": simulated_joint_bounds(run_dir / "session.mcap"), **latencies(turns)}
 
 
 def main() -> None:
@@ -187,13 +202,7 @@ def main() -> None:
     parser.add_argument("--pages", type=int, default=0, help="WebSocket pages watching (frames rendered)")
     parser.add_argument("--extra", nargs="*", default=[], help="more overrides for the serve command")
     parser.add_argument("--run-dir", type=Path, default=None, help="keep the run here (default: a temp dir)")
-    args = parser.parse_args()
-    if args.run_dir is not None:
-        args.run_dir.mkdir(parents=True, exist_ok=True)
-        print(json.dumps(measure(args, args.run_dir), indent=2))
-        return
-    with tempfile.TemporaryDirectory(prefix="emopose-live-") as folder:
-        print(json.dumps(measure(args, Path(folder)), indent=2))
+    measure_and_print(measure, parser.parse_args(), "emopose-live-")
 
 
 if __name__ == "__main__":

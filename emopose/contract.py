@@ -27,8 +27,8 @@ PlanSource = Literal["model", "retried", "scripted", "plain_text", "empty", "unk
 USABLE_SOURCES = frozenset({"model", "retried", "scripted"})
 
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
-# The longest reply a plan carries: the parser cuts a model's JSON reply (and each record's text) to it,
-# and the tour plans a longer line in pieces of whole sentences under it.
+# The longest text of a record (the parser cuts a trigger or variant to it at a word), and the piece a
+# tour line is planned in (whole sentences under it); a reply keeps more (stages/parse.py MAX_SPOKEN_CHARS).
 MAX_REPLY_CHARS = 200
 
 
@@ -37,7 +37,8 @@ class EventKind(StrEnum):
     (/sequencer/events), Turn.to_json and the sync measurement keep the string values."""
 
     STARTED = "started"
-    STROKE = "stroke"  # the arm reached the stroke
+    STROKE = "stroke"  # the arm reached the stroke (measured joints where the backend measures them)
+    STROKE_COMMANDED = "stroke_commanded"  # the command stream reached it (only beside a measured STROKE)
     COMPLETED = "completed"
     CUT = "cut"  # ended after its stroke: co-articulated into, or preempted by, the next gesture
     STOPPED = "stopped"  # interrupted, or cut short by an overdue successor

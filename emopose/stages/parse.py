@@ -5,6 +5,9 @@ clamps intensity to the integers 1..5 and confidence to [0, 1], maps an unknown 
 turns plain text into one neutral record, and on a JSON decode or value failure falls back to the
 keyword classifier, logging that it did. Plan.source says honestly which of these happened
 (emopose/contract.py, PlanSource): only "model" and "retried" are the model's own usable records.
+A reply keeps up to MAX_SPOKEN_CHARS characters, the longest utterance the web UI accepts (so a narrated
+line is spoken whole); a longer one, and a record's text past MAX_REPLY_CHARS, is cut at a word, never
+inside one.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from emopose.turn.model import Turn
 log = logging.getLogger(__name__)
 
 MAX_RAW_CHARS = 64_000
+MAX_SPOKEN_CHARS = 2000  # the longest reply, and the input limit of serve (/api/say, the page's box)
 MAX_RECORDS = 8
 _FENCE = re.compile(r"```(?:json|JSON)?\s*(.*?)```", re.DOTALL)
 
@@ -57,13 +61,21 @@ def _number(value: Any, field: str) -> float:
     return number
 
 
-def _text(value: Any) -> str | None:
+def cut_at_word(text: str, limit: int) -> str:
+    """At most `limit` characters of `text`, ending at a word boundary (whole text when it fits)."""
+    text = text.strip()
+    if len(text) <= limit:
+        return text
+    cut = max(text.rfind(" ", 0, limit + 1), text.rfind("\n", 0, limit + 1))
+    return text[:cut].rstrip() if cut > 0 else text[:limit]  # no boundary: not a word either
+
+
+def _text(value: Any, limit: int = MAX_REPLY_CHARS) -> str | None:
     if value is None:
         return None
     if not isinstance(value, (str, int, float)):
         raise PlanValueError(f"expected text, got {type(value).__name__}")
-    text = str(value).strip()
-    return text[:MAX_REPLY_CHARS] or None
+    return cut_at_word(str(value), limit) or None
 
 
 def _record(raw: Any) -> tuple[GestureRecord, str | None]:
@@ -94,7 +106,7 @@ def _plan_from_json(data: Any, fallback_reply: str) -> Plan:
     gestures = data.get("gestures", data.get("records", []))
     if not isinstance(gestures, list):
         raise PlanValueError("gestures must be a list")
-    reply = _text(data.get("reply")) if data.get("reply") is not None else None
+    reply = _text(data.get("reply"), MAX_SPOKEN_CHARS) if data.get("reply") is not None else None
     records, notes, source = [], [], "model"
     for raw in gestures[:MAX_RECORDS]:
         record, unknown = _record(raw)
@@ -120,14 +132,15 @@ def parse_plan(raw: str | None, utterance: str = "", line: str | None = None) ->
                     notes=("empty model output; one neutral record",))
     candidate = _json_candidate(text)
     if candidate is None:
-        return Plan(reply=line or text.strip()[:2000], records=(GestureRecord(cls="neutral"),),
-                    source="plain_text", notes=("plain-text answer; one neutral record",))
+        return Plan(reply=line or cut_at_word(text, MAX_SPOKEN_CHARS),
+                    records=(GestureRecord(cls="neutral"),), source="plain_text",
+                    notes=("plain-text answer; one neutral record",))
     try:
         return _plan_from_json(json.loads(candidate), utterance)
     except (json.JSONDecodeError, PlanValueError, RecursionError, ValueError) as exc:
         log.warning("model output unusable (%s); keyword fallback", str(exc)[:200])
         source_text = line or utterance or text
-        return Plan(reply=line or utterance or text.strip()[:2000],
+        return Plan(reply=line or utterance or cut_at_word(text, MAX_SPOKEN_CHARS),
                     records=tuple(keyword_records(source_text)), source="keyword_fallback",
                     notes=(f"keyword fallback: {str(exc)[:200]}",))
 

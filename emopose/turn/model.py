@@ -161,7 +161,7 @@ def _speech_json(clip: SpeechClip) -> dict:
 
 def _json(value: object) -> object:
     if isinstance(value, PlanRequest):
-        return {"utterance": value.utterance, "history": list(value.history),
+        return {"utterance": value.utterance, "history_messages": len(value.history),  # on /dialogue
                 "image": value.image is not None}
     if isinstance(value, PlannerOutput):
         return {"raw": value.raw, "latency_s": value.latency_s, "fallback": value.fallback,

@@ -13,6 +13,7 @@ from fastapi.responses import FileResponse
 
 from emopose.contract import GestureRecord
 from emopose.speech.asr import ASRError
+from emopose.stages.parse import MAX_SPOKEN_CHARS
 from emopose.stages.resolve import resolve_record
 from emopose.web.schemas import GestureRequest, ResolveRequest, SayRequest
 from emopose.web.session import LiveSession, UnknownMotion
@@ -91,7 +92,7 @@ async def utterance_audio(request: Request) -> dict:
     session = session_of(request)
     if not session.hears_speech:
         raise HTTPException(409, "no speech recognition configured; "
-                                 "type the utterance (or run with asr=litellm)")
+                                 "type the utterance (or run with asr=whisper, local, or asr=litellm)")
     media = request.headers.get("content-type", "").split(";")[0].strip().lower()
     if media not in AUDIO_TYPES:
         raise HTTPException(415, f"audio type {media!r} not accepted; use one of {sorted(AUDIO_TYPES)}")
@@ -107,7 +108,10 @@ async def utterance_audio(request: Request) -> dict:
             raise HTTPException(422, str(exc)) from exc
     if not text.strip():
         raise HTTPException(422, "the recording contained no recognisable speech")
-    return await session.say(text[:2000])
+    if len(text) > MAX_SPOKEN_CHARS:
+        raise HTTPException(422, f"the transcript has {len(text)} characters; the input limit is "
+                                 f"{MAX_SPOKEN_CHARS}: speak a shorter utterance")
+    return await session.say(text)
 
 
 def camera_image(session: LiveSession) -> bytes | None:

@@ -11,12 +11,13 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from emopose import CLASSES
+from emopose.stages.parse import MAX_SPOKEN_CHARS
 from emopose.studio.saving import NAME_PATTERN
 
 MotionName = Annotated[str, Field(pattern=NAME_PATTERN, description="a library motion name")]
 GestureClass = Literal[CLASSES]  # type: ignore[valid-type]
 Keyframe = Annotated[list[float], Field(min_length=14, max_length=14)]
-Intensity = Annotated[int, Field(ge=1, le=5)]
+Intensity = Annotated[int, Field(ge=1, le=5, strict=True)]  # strict: "3" is refused, not coerced
 
 
 class _Strict(BaseModel):
@@ -24,8 +25,8 @@ class _Strict(BaseModel):
 
 
 class SayRequest(_Strict):
-    text: str = Field(min_length=1, max_length=2000)
-    attach_camera: bool = False  # send the current camera frame to the planner as the turn's image
+    text: str = Field(min_length=1, max_length=MAX_SPOKEN_CHARS)  # the input limit, in /api/info
+    attach_camera: bool = Field(default=False, strict=True)  # send the camera frame with the turn
 
 
 class GestureRequest(_Strict):
@@ -68,12 +69,16 @@ class SaveRequest(_Strict):
     duration: float | None = Field(default=None, gt=0.0, le=20.0)
     stroke: tuple[int, int] | None = None
     keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
-    overwrite: bool = False
+    overwrite: bool = Field(default=False, strict=True)
 
     def motion(self) -> dict:
         """The library-file mapping (what MotionLibrary.save validates)."""
         data = self.model_dump(by_alias=True, exclude={"overwrite"}, exclude_none=True)
         return data
+
+
+class RenameRequest(_Strict):
+    new_name: str = Field(min_length=1, max_length=64)  # checked against the pattern in saving.py
 
 
 # -- WebSocket, client -> server ---------------------------------------------------------------

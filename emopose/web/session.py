@@ -3,10 +3,12 @@
 Turns (planning, TTS, the pipeline) run through the run's TurnRunner on one worker thread, so the event
 loop never blocks and turns never overlap (the runner's dialogue grows in order); the control
 loop ticks on its own thread. A streamed reply publishes each sentence as a turn once it is handed over.
-Everything a page must hear about (turns, interruptions, saved motions) goes into one bounded log
-with increasing ids; each WebSocket sends what it has not sent yet, so every open page agrees.
-A turn is published before its gestures start; when the sequencer later rejects or drops one, the
-turn's cue in the log gets its outcome and a `cue_outcome` message tells the open pages.
+Everything a page must hear about (turns, interruptions, saved motions, a failed planner call) goes into
+one bounded log with increasing ids; each WebSocket sends what it has not sent yet, so every open page
+agrees. A turn is published before its gestures start; what the sequencer later does with its gestures
+reaches its cues through emopose/web/cue_outcomes.py. Every published message is also counted (every
+turn, however long the session: emopose/web/serve_tally.py), and the runner's dialogue reads the window
+serve.history_turns / serve.history_tokens (emopose/turn/dialogue.py).
 """
 
 from __future__ import annotations
@@ -22,15 +24,21 @@ from pathlib import Path
 import numpy as np
 
 from emopose.backends.capabilities import SimulatedState
-from emopose.contract import EventKind, GestureRecord, LibraryEntry, Plan
+from emopose.contract import GestureRecord, LibraryEntry, Plan
+from emopose.planners.base import ModalPlanner, PlannerMode
 from emopose.resources import Run
+from emopose.stages.parse import MAX_SPOKEN_CHARS
 from emopose.studio.authoring import PoseStudio
+from emopose.turn.dialogue import HistoryWindow
 from emopose.turn.model import ResolvedGesture, Turn
+from emopose.web.clients import Clients
+from emopose.web.cue_outcomes import CueOutcomes, remember
+from emopose.web.serve_tally import SOURCE_WORDS, TurnTally, failure_banner
 from emopose.web.settings import ServeSettings
 from emopose.web.stick_figure import stick_figure
-from emopose.web.turns import outcome_of, summarize_turn
+from emopose.web.turns import summarize_turn
 
-TRACKED_COMMANDS = 2048  # command ids remembered for late outcomes (far more than the log's turns hold)
+SHARED_STATE_S = 0.04  # pages share a state this fresh (the stick figure's kinematics cost ~3 ms)
 
 
 class UnknownMotion(LookupError):
@@ -48,13 +56,13 @@ class LiveSession:
         self._log: deque[dict] = deque(maxlen=settings.max_turns_kept)
         self._next_id = 1
         self._turn_ids = itertools.count(1)
-        self._audio: dict[int, Path] = {}
-        self._stick: tuple[float, dict] | None = None
-        self._outcome_lock = threading.Lock()
-        self._events_seen = res.sequencer.events.total
-        self._cue_of: dict[int, tuple[dict, int]] = {}  # command id -> (published turn message, cue index)
-        self._refusals: dict[int, dict] = {}  # command id -> outcome (may precede its turn)
-        self._strokes: dict[int, float] = {}  # command id -> clock time its stroke arrived
+        self._audio: dict[int, Path] = {}  # the newest turns' WAVs (bounded like the outcome tables)
+        self._shared_state: tuple[float, dict] | None = None  # (monotonic time, state without events)
+        self.outcomes = CueOutcomes(res.sequencer.events, self.publish)
+        self.clients = Clients(settings)
+        self.tally = TurnTally(run.session.run_dir / "turns.jsonl")
+        self.planner_failure: dict | None = None  # the newest planned turn's failed call, for a banner
+        run.runner.dialogue.window = HistoryWindow(settings.history_turns, settings.history_tokens)
 
     # -- turns (called from the event loop; the work runs on the worker thread) ----------------
     async def say(self, text: str, image: bytes | None = None) -> dict:
@@ -68,7 +76,7 @@ class LiveSession:
 
     @property
     def hears_speech(self) -> bool:
-        """True when the configured ASR transcribes audio (asr=litellm): the page shows its microphone."""
+        """True when the configured ASR transcribes audio (asr=whisper or litellm): the page shows a mic."""
         return self.res.asr is not None and self.res.asr.accepts_audio
 
     async def transcribe(self, audio_path: Path) -> str:
@@ -109,60 +117,16 @@ class LiveSession:
         audio = turn.speech.audio_path if turn.speech is not None else None
         url = None
         if audio is not None and Path(audio).is_file():
-            self._audio[turn_id] = Path(audio)
+            remember(self._audio, turn_id, Path(audio))
             url = f"/api/audio/{turn_id}"
         message = self.publish(summarize_turn(turn, turn_id, kind, url, self.res.library.version))
-        with self._outcome_lock:
-            ids = [cue["command_id"] for cue in message["cues"]]
-            for k, command_id in enumerate(ids):
-                if command_id is not None:
-                    _remember(self._cue_of, command_id, (message, k))
-            landed = [self._land(command_id) for command_id in ids if command_id in self._refusals]
-            landed += [self._land_stroke(command_id) for command_id in ids if command_id in self._strokes]
-        self._publish_outcomes(landed)
+        self.outcomes.track_turn(message)
+        if turn.planner_output is not None:  # planned (not scripted): the banner follows the newest call
+            failed = turn.planner_output.fallback
+            self.planner_failure = failure_banner(turn_id, turn.planner_output.error) if failed else None
+            if failed:
+                self.publish(self.planner_failure)
         return message
-
-    def _track_outcomes(self) -> None:
-        """Put the sequencer's new rejections, drops and arrived strokes on their published cues (and
-        tell the pages).
-
-        A refusal may come before its turn is published (then _publish_turn lands it); an event read
-        twice (appended while the cursor moved) lands once."""
-        events = self.res.sequencer.events
-        with self._outcome_lock:
-            cursor, self._events_seen = self._events_seen, events.total
-            landed = []
-            for event in events.since(cursor):
-                if event.kind == EventKind.STROKE and event.command_id is not None:
-                    _remember(self._strokes, event.command_id, event.t)
-                    landed.append(self._land_stroke(event.command_id))
-                    continue
-                outcome = outcome_of({"kind": event.kind, "detail": event.detail})
-                if outcome is not None and event.command_id is not None:
-                    _remember(self._refusals, event.command_id, outcome)
-                    landed.append(self._land(event.command_id))
-        self._publish_outcomes(landed)
-
-    def _land(self, command_id: int) -> dict | None:
-        """Set a refused command's outcome on its published cue; the page message, or None (caller locks)."""
-        message, k = self._cue_of.get(command_id, (None, None))
-        if message is None or message["cues"][k]["outcome"] is not None:
-            return None
-        outcome = message["cues"][k]["outcome"] = self._refusals[command_id]
-        return {"type": "cue_outcome", "turn_id": message["turn_id"], "k": k, "outcome": outcome}
-
-    def _land_stroke(self, command_id: int) -> dict | None:
-        """Put an arrived stroke's time (from speech start) on its published cue; the page message."""
-        message, k = self._cue_of.get(command_id, (None, None))
-        cue = None if message is None else message["cues"][k]
-        if cue is None or cue["stroke_executed_s"] is not None or message["speech_start"] is None:
-            return None
-        executed = cue["stroke_executed_s"] = self._strokes[command_id] - message["speech_start"]
-        return {"type": "cue_stroke", "turn_id": message["turn_id"], "k": k, "executed_s": executed}
-
-    def _publish_outcomes(self, landed: list[dict | None]) -> None:
-        for update in filter(None, landed):
-            self.publish(update)
 
     def interrupt(self) -> dict:
         self.run.runner.silence()
@@ -174,10 +138,11 @@ class LiveSession:
             message = {**message, "id": self._next_id, "server_now": self.res.clock.now()}
             self._next_id += 1
             self._log.append(message)
+            self.tally.observe(message)
         return message
 
     def log_since(self, last_id: int) -> list[dict]:
-        self._track_outcomes()
+        self.outcomes.track()
         with self._lock:
             return [m for m in self._log if m["id"] > last_id]
 
@@ -193,33 +158,32 @@ class LiveSession:
         q = self.res.backend.measured()
         return (self.res.sequencer.last.copy() if q is None else np.asarray(q, float)), qpos
 
-    def status(self, events_from: int = 0) -> dict:
-        seq, clock = self.res.sequencer, self.res.clock
-        self._track_outcomes()
-        now, active = clock.now(), seq.active
-        events, events_next = seq.events.read(events_from)
-        session = self.run.session
+    def status(self, events_from: int = 0, shared: bool = False) -> dict:
+        """The live state with the sequencer's events from `events_from` on. `shared` (a page's push): the
+        rest as computed for any page at most SHARED_STATE_S ago, so many pages cost what one does."""
+        self.outcomes.track()
+        events, events_next = self.res.sequencer.events.read(events_from)
+        cached = self._shared_state
+        if not shared or cached is None or time.monotonic() - cached[0] > SHARED_STATE_S:
+            cached = self._shared_state = (time.monotonic(), self._state())
+        return {**cached[1], "events_next": events_next,
+                "events": [{"t": e.t, "kind": e.kind, "name": e.name, "detail": e.detail} for e in events]}
+
+    def _state(self) -> dict:
+        seq, now, session = self.res.sequencer, self.res.clock.now(), self.run.session
+        active = seq.active
         return {
             "type": "state", "server_now": now, "state": seq.state.value,
             "active": None if active is None
             else {"name": active.name, "label": active.label, "id": active.id},
             "pending": [{"name": c.name, "label": c.label, "release_in_s": round(c.release_at - now, 3)}
                         for c in seq.pending],
-            "events": [{"t": e.t, "kind": e.kind, "name": e.name, "detail": e.detail} for e in events],
-            "events_next": events_next,
             "loop": None if not session.is_open else {"running": session.loop.running,
                                                       "missed": session.loop.stats.missed_deadlines,
                                                       **session.loop.stats.summary()},
-            "library_version": self.res.library.version, "stick": self._stick_now(),
+            "library_version": self.res.library.version, "stick": stick_figure(self.pose()[0]),
+            "clients": self.clients.counters(), "planner_failure": self.planner_failure,
         }
-
-    def _stick_now(self) -> dict:
-        """Forward kinematics once per 40 ms however many pages ask (it costs ~3 ms)."""
-        cached = self._stick
-        if cached is None or time.monotonic() - cached[0] > 0.04:
-            cached = (time.monotonic(), stick_figure(self.pose()[0]))
-            self._stick = cached
-        return cached[1]
 
     def info(self) -> dict:
         channels = self.frames.channels if self.frames is not None else {}
@@ -229,6 +193,10 @@ class LiveSession:
             "asr": self.hears_speech, "channels": {name: c.source for name, c in channels.items()},
             "render": self.renderer is not None and self.renderer.available,
             "render_error": None if self.renderer is None else self.renderer.error,
+            "sources": SOURCE_WORDS,  # each plan source in words a visitor reads
+            "narrates": narrates(self.res.planner),  # the page's mode hint before the first turn
+            "limits": {"utterance_chars": MAX_SPOKEN_CHARS, "max_clients": self.settings.max_clients},
+            "history": {"turns": self.settings.history_turns, "tokens": self.settings.history_tokens},
         }
 
     def close(self) -> None:
@@ -241,8 +209,7 @@ class LiveSession:
             self.renderer.close()
 
 
-def _remember(table: dict, key: int, value: object) -> None:
-    """Insert into a dict kept to the TRACKED_COMMANDS newest keys (dicts keep insertion order)."""
-    table[key] = value
-    while len(table) > TRACKED_COMMANDS:
-        del table[next(iter(table))]
+def narrates(planner) -> bool:
+    """Whether the robot says the visitor's text (narrate) or the planner writes a reply: planners without a
+    mode (the local and keyword ones) only choose gestures for the words they are given."""
+    return planner.mode is PlannerMode.NARRATE if isinstance(planner, ModalPlanner) else True

@@ -46,7 +46,12 @@ class ServeSettings(BaseModel):
     render_height: int = Field(240, ge=48, le=1080)
     render_quality: Literal["fast", "full"] = "fast"  # fast: no MSAA/shadows (software EGL stays >= 10 fps)
     preview_frames: int = Field(12, ge=1, le=60)  # Pose Studio MuJoCo preview frames per request
-    max_turns_kept: int = Field(100, ge=1)
+    max_turns_kept: int = Field(100, ge=1)  # the page's log; results count every turn (turns.jsonl)
+    max_clients: int = Field(16, ge=1, le=10_000)  # pages open at once; one more is closed with code 1013
+    push_budget_hz: float = Field(400.0, gt=0)  # WebSocket pushes a second, all pages together
+    min_push_hz: float = Field(1.0, gt=0, le=50)  # the slowest a busy or slow page is pushed to
+    history_turns: int = Field(12, ge=0)  # the dialogue window planners read (emopose/turn/dialogue.py)
+    history_tokens: int = Field(2000, ge=0)  # estimated tokens (characters / 4) in that window
 
     @model_validator(mode="after")
     def _token_for_network(self) -> ServeSettings:

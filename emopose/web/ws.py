@@ -1,9 +1,10 @@
 """The page's WebSocket: actions in (say, gesture, interrupt), live state and frames out.
 
 Receiving and sending run side by side: a turn is started as a task, so an interrupt sent while the
-planner works is handled at once. The sender pushes, at serve.state_hz, the sequencer state with
-new events, the stick figure, every new broadcast-log message (turns, interruptions, saves) and the
-newest frame of each image channel as a binary message: one tag byte ('s' sim, 'c' camera) + JPEG.
+planner works is handled at once. The sender pushes, each cycle, every new broadcast-log message (turns,
+interruptions, saves), the sequencer state with new events and the stick figure (at most at
+serve.state_hz), and the newest frame of each image channel as a binary message: one tag byte ('s' sim,
+'c' camera) + JPEG. How many pages may watch and how fast each is pushed: emopose/web/clients.py.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from pydantic import TypeAdapter, ValidationError
 
 from emopose.web.api import camera_image
+from emopose.web.clients import REFUSED_CODE, Pacer
 from emopose.web.schemas import ClientMessage, GestureMessage, InterruptMessage, SayMessage
 from emopose.web.session import LiveSession, UnknownMotion
 
@@ -28,6 +30,16 @@ _messages = TypeAdapter(ClientMessage)
 async def websocket_endpoint(websocket: WebSocket) -> None:
     session: LiveSession = websocket.app.state.session
     await websocket.accept()
+    if not session.clients.admit():
+        await websocket.close(code=REFUSED_CODE, reason=session.clients.refusal())
+        return
+    try:
+        await _serve_page(websocket, session)
+    finally:
+        session.clients.leave()
+
+
+async def _serve_page(websocket: WebSocket, session: LiveSession) -> None:
     await websocket.send_json({"type": "hello", **session.info(), "log": session.log_since(0)})
     watching = session.frames.watching() if session.frames is not None else None
     if watching is not None:
@@ -97,28 +109,30 @@ async def _send_quietly(websocket: WebSocket, message: dict) -> None:
 
 
 async def _send_loop(websocket: WebSocket, session: LiveSession) -> None:
-    settings = session.settings
+    settings, pacer, clock = session.settings, Pacer(session.clients), asyncio.get_running_loop()
     last_id = max((m["id"] for m in session.log_since(0)), default=0)
     events_from = session.res.sequencer.events.total
     frames_seen: dict[str, int] = {}
-    period = 1.0 / max(settings.state_hz, settings.sim_fps)
-    state_every, tick = max(1, round(max(settings.state_hz, settings.sim_fps) / settings.state_hz)), 0
+    state_due, late = 0.0, 0.0
     try:
         while True:
+            started = clock.time()
             for message in session.log_since(last_id):
                 last_id = message["id"]
                 await websocket.send_text(json.dumps({**message, "now": session.res.clock.now()}))
-            if tick % state_every == 0:
-                state = session.status(events_from)
+            if started >= state_due:
+                state = session.status(events_from, shared=True)
                 events_from = state.pop("events_next")
                 await websocket.send_text(json.dumps(state))
-            tick += 1
+                state_due = started + 1.0 / settings.state_hz
             if session.frames is not None:
                 for name in session.frames.channels:
                     seq, jpeg = session.frames.latest(name)
                     if jpeg is not None and frames_seen.get(name) != seq:
                         frames_seen[name] = seq
                         await websocket.send_bytes(name[0].encode() + jpeg)
-            await asyncio.sleep(period)
+            period = pacer.next_period(late)
+            await asyncio.sleep(max(0.0, period - (clock.time() - started)))
+            late = clock.time() - started - period  # sends that blocked, or a loop too busy to wake us
     except (WebSocketDisconnect, RuntimeError, asyncio.CancelledError):
         return
