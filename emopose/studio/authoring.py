@@ -15,6 +15,7 @@ the timeline checks and replaces by a retraction when unsafe, and a real robot's
 
 from __future__ import annotations
 
+import re
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -168,9 +169,9 @@ class PoseStudio:
     def _check_from(self, entry: LibraryEntry, label: str, start: np.ndarray) -> StartCheck:
         failed, first = [], None
         for level in LEVELS:
-            samples = self.builder.build(self.modulate.keyframes(entry.q, level), entry.default_duration,
-                                         start).samples
-            reason = self._refusal(samples)
+            trajectory = self.builder.build(self.modulate.keyframes(entry.q, level), entry.default_duration,
+                                            start)
+            reason = self._refusal(trajectory)
             if reason is not None:
                 failed.append(level)
                 first = first or reason
@@ -178,13 +179,39 @@ class PoseStudio:
 
     def _check(self, level: int, trajectory: Trajectory) -> LevelCheck:
         collision = self.checker.check(trajectory.samples)
-        reason = self._refusal(trajectory.samples, collision.reason)
+        reason = self._refusal(trajectory, collision.reason)
         return LevelCheck(level, reason is None, reason, float(collision.min_clearance_m),
                           float(trajectory.stretch))
 
-    def _refusal(self, samples: np.ndarray, checked: str | None = "unchecked") -> str | None:
+    def _refusal(self, trajectory: Trajectory, checked: str | None = "unchecked") -> str | None:
         """The sequencer's hook is the authority (it carries the configured clearance); without one
-        (safety=off) the default checker still informs the author (`checked`: its verdict, if known)."""
+        (safety=off) the default checker still informs the author (`checked`: its verdict, if known).
+        The reason names a time and keyframes, not a sample index."""
+        samples = trajectory.samples
         if self.safety is not None:
-            return self.safety(samples)
-        return self.checker.check(samples).reason if checked == "unchecked" else checked
+            reason = self.safety(samples)
+        else:
+            reason = self.checker.check(samples).reason if checked == "unchecked" else checked
+        return None if reason is None else cite_time(reason, trajectory)
+
+
+def cite_time(reason: str, trajectory: Trajectory) -> str:
+    """'... at sample 22: ...' as '... at 0.44 s (between K1 and K2): ...': what the author can find on
+    the timeline. Anchor 0 is the start pose (in a sequence it takes keyframe 0's place, so anchor i is
+    keyframe i); a pose has two anchors, the start and its one keyframe K0."""
+    ticks = trajectory.anchor_ticks
+    names = ["the start", "K0"] if len(ticks) == 2 else [f"K{i}" for i in range(len(ticks))]
+
+    def where(match: re.Match) -> str:
+        n = int(match.group(1))
+        at = f"at {n * trajectory.dt:.2f} s"
+        if not ticks:
+            return at
+        i = max(k for k, tick in enumerate(ticks) if tick <= n)
+        if n == ticks[i]:
+            return f"{at} (at {names[i]})"
+        if i + 1 < len(ticks):
+            return f"{at} (between {names[i]} and {names[i + 1]})"
+        return f"{at} (after {names[i]})"
+
+    return re.sub(r"at sample (\d+)", where, reason)

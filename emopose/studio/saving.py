@@ -81,3 +81,53 @@ def save_motion(studio: PoseStudio, raw: dict, overwrite: bool = False) -> SaveR
         raise SaveRefused(str(exc)) from exc
     return SaveResult(saved, target, backup if backup and backup.exists() else None, library.version,
                       replaced)
+
+
+def _removable(library: MotionLibrary, name: str) -> Path:
+    """The file of a motion that may be deleted or renamed: it exists in a writable library folder, is not
+    the neutral rest pose nor a configured class default, and is not the last motion of its class (the
+    resolver needs one per class)."""
+    path = target_path(library, name)
+    entry = library.get(name)
+    if entry is None:
+        raise SaveRefused(f"no motion named {name!r}", 404)
+    if name == library.neutral:
+        raise SaveRefused(f"{name!r} is the neutral rest pose; every gesture starts and ends there", 409)
+    if name in library.class_defaults.values():
+        raise SaveRefused(f"{name!r} is a configured class default (library.class_defaults)", 409)
+    if len(library.snapshot.by_class(entry.cls)) <= 1:
+        raise SaveRefused(f"{name!r} is the only {entry.cls} motion; the resolver needs one per class", 409)
+    return path
+
+
+def _retire(library: MotionLibrary, path: Path) -> Path:
+    """Move a motion's file into .backup/ (as a save keeps a replaced file) and reload the library."""
+    backup = path.parent / ".backup" / f"{path.stem}.v{library.version}.removed.yaml"
+    backup.parent.mkdir(exist_ok=True)
+    path.replace(backup)
+    try:
+        library.reload()
+    except LibraryError:
+        backup.replace(path)  # the library must stay loadable: put the file back
+        library.reload()
+        raise
+    return backup
+
+
+def delete_motion(library: MotionLibrary, name: str) -> Path:
+    """Remove a motion from the live library; its file is kept in .backup/. Returns the backup."""
+    path = _removable(library, name)
+    try:
+        return _retire(library, path)
+    except LibraryError as exc:
+        raise SaveRefused(f"{name!r} not deleted: {exc}", 409) from exc
+
+
+def rename_motion(studio: PoseStudio, name: str, new_name: str) -> SaveResult:
+    """Save the motion under new_name (every save check) and retire the old file into .backup/."""
+    library = studio.library
+    path = _removable(library, name)
+    raw = library.get(name).model_dump(mode="json", by_alias=True, exclude_none=True) | {"name": new_name}
+    saved = save_motion(studio, raw)  # refuses an existing or malformed new name
+    backup = _retire(library, path)
+    return SaveResult(saved.entry, saved.file, backup, library.version, replaced=False)

@@ -16,9 +16,9 @@ from fastapi.responses import JSONResponse
 from emopose import CLASSES
 from emopose.contract import LibraryEntry
 from emopose.studio.authoring import DraftError, DraftReport
-from emopose.studio.saving import NAME_PATTERN, SaveRefused, save_motion
+from emopose.studio.saving import NAME_PATTERN, SaveRefused, delete_motion, rename_motion, save_motion
 from emopose.web.pose_renderer import RenderUnavailable
-from emopose.web.schemas import DraftRequest, PerformRequest, PreviewRequest, SaveRequest
+from emopose.web.schemas import DraftRequest, PerformRequest, PreviewRequest, RenameRequest, SaveRequest
 from emopose.web.session import LiveSession
 from emopose.web.stick_figure import stick_frames
 
@@ -130,9 +130,38 @@ def save(body: SaveRequest, request: Request):
         result = save_motion(session.studio, body.motion(), overwrite=body.overwrite)
     except SaveRefused as exc:
         return JSONResponse({"error": str(exc)}, status_code=exc.status)
+    return _saved(session, result)
+
+
+def _saved(session: LiveSession, result) -> dict:
     folder = result.file.parent.name  # shown relative to the library folder, never as an absolute path
     saved = {"name": result.entry.name, "class": result.entry.cls, "version": result.version,
              "replaced": result.replaced, "file": f"{folder}/{result.file.name}",
              "backup": None if result.backup is None else f"{folder}/.backup/{result.backup.name}"}
     session.publish({"type": "library_saved", **saved})
     return saved
+
+
+@router.post("/library/{name}/rename")
+def rename(body: RenameRequest, request: Request, name: str = Path(pattern=NAME_PATTERN)):
+    """The motion under a new name (every save check); the old file is kept in .backup/."""
+    session = session_of(request)
+    try:
+        return _saved(session, rename_motion(session.studio, name, body.new_name))
+    except SaveRefused as exc:
+        return JSONResponse({"error": str(exc)}, status_code=exc.status)
+
+
+@router.post("/library/{name}/delete")
+def delete(request: Request, name: str = Path(pattern=NAME_PATTERN)):
+    """Remove a motion (not the rest pose, a class default or a class's last motion); a backup is kept."""
+    session = session_of(request)
+    library = session.res.library
+    try:
+        backup = delete_motion(library, name)
+    except SaveRefused as exc:
+        return JSONResponse({"error": str(exc)}, status_code=exc.status)
+    folder = backup.parent.parent.name
+    deleted = {"name": name, "version": library.version, "backup": f"{folder}/.backup/{backup.name}"}
+    session.publish({"type": "library_deleted", **deleted})
+    return deleted

@@ -82,6 +82,9 @@ def summarize_turn(turn: Turn, turn_id: int, kind: str, audio_url: str | None, l
         else submitted["speech_start"] if submitted else None,
         "planner_latency_s": output["latency_s"] if output else 0.0,
         "planner_error": output["error"] if output else None,
+        # the dialogue the planner was given, and whether it read it (planners that say so in meta)
+        "history_messages": data["request"]["history_messages"],
+        "history_used": output["meta"].get("history_used") if output else None,
         "stage_ms": {k: round(v, 2) for k, v in data["stage_ms"].items()},
         "library_version": library_version,
     }

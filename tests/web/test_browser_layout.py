@@ -92,3 +92,36 @@ def test_a_rejected_gesture_is_shown_rejected_and_named_gestures_are_silent(brow
         page.reload()  # a page opened later sees the outcome in the history
         expect(page.locator(".bubble.robot").last.locator(".outcome")).to_contain_text("rejected:",
                                                                                        timeout=10_000)
+
+
+WIDTHS = (420, 900, 1400)
+
+
+@pytest.mark.parametrize("width", WIDTHS)
+def test_interrupt_stays_put_on_screen_and_nothing_scrolls_sideways(browser, server, width):
+    """Issue 31: at 420, 900 and 1400 px (900 px high) the page never scrolls sideways, Interrupt is on
+    screen without scrolling and does not move as events come and go, and cue rows fit their bubble."""
+    with watched_page(browser, server["base"], width, 900) as page:
+        page.goto(server["base"] + "/")
+        expect(page.locator("#connection")).to_have_text("live", timeout=15_000)
+        button = page.locator("#interrupt")
+        before = button.bounding_box()
+        assert inside(before, width, 900), (width, before)
+        page.fill("#say-text", "Welcome! Look over there on the left, it is really important, I am not sure.")
+        page.click("#send")
+        bubble = page.locator(".bubble.robot:not(.pending)").last
+        expect(bubble.locator(".cue").first).to_be_visible(timeout=10_000)
+        expect(page.locator("#events li").nth(2)).to_be_visible(timeout=10_000)
+        where = "(() => { const r = document.getElementById('interrupt').getBoundingClientRect();"\
+                " return [r.left + scrollX, r.top + scrollY]; })()"  # in the page: scrolling is no move
+        placed = [before["x"], before["y"]]
+        for _ in range(5):
+            assert page.evaluate(where) == pytest.approx(placed), f"Interrupt moved from {placed}"
+            page.wait_for_timeout(300)
+        assert no_sideways_scroll(page, width)
+        frame = bubble.bounding_box()
+        for row in bubble.locator(".cue").all():
+            box = row.bounding_box()
+            assert box["x"] + box["width"] <= frame["x"] + frame["width"] + 0.5, (width, box, frame)
+        SHOTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(SHOTS / f"chat_{width}.png"))

@@ -6,11 +6,14 @@ restart: MotionLibrary.save reloads and the resolver and guide read the live lib
 
 from __future__ import annotations
 
+import re
+
 import pytest
 import yaml
 
 from tests.web.conftest import SHIPPED
 from tests.web.test_api import motion_body, wait_for
+from tests.web.test_cue_outcomes import REACH_IN, REST
 
 
 # -- Pose Studio -----------------------------------------------------------------------------------
@@ -175,3 +178,41 @@ def test_perform_refuses_a_draft_that_collides_at_the_requested_intensity(client
     assert ok.status_code == 200
     refused = client.post("/api/studio/perform", json={"keyframes": [rest, inward, rest], "intensity": 5})
     assert refused.status_code == 422 and "self-collision at intensity 5" in refused.json()["error"]
+
+
+# -- delete and rename (issue 31): the library's usual checks, a backup of every removed file ---------
+def test_a_motion_is_renamed_with_a_backup_and_the_usual_checks(client, library_copy):
+    assert client.post("/api/library/point_left/rename", json={"new_name": "point_up"}).status_code == 409
+    assert client.post("/api/library/point_left/rename", json={"new_name": "Bad Name"}).status_code == 422
+    assert client.post("/api/library/palm_stop/rename", json={"new_name": "stop_sign"}).status_code == 409
+    renamed = client.post("/api/library/point_left/rename", json={"new_name": "point_aside"})
+    assert renamed.status_code == 200, renamed.text
+    assert renamed.json()["name"] == "point_aside" and renamed.json()["backup"].endswith(".removed.yaml")
+    assert client.get("/api/library/point_left").status_code == 404
+    assert client.get("/api/library/point_aside").json()["class"] == "pointing"
+    assert not (library_copy / "point_left.yaml").exists() and (library_copy / "point_aside.yaml").is_file()
+    assert list((library_copy / ".backup").glob("point_left.v*.removed.yaml"))
+
+
+def test_a_motion_is_deleted_unless_the_library_needs_it(client, library_copy):
+    names = {e["name"]: e["class"] for e in client.get("/api/library").json()["entries"]}
+    assert client.post("/api/library/neutral_rest/delete", json={}).status_code == 409  # gestures end there
+    assert client.post("/api/library/idle_breathe/delete", json={}).status_code == 409  # a class default
+    assert client.post("/api/library/no_such_motion/delete", json={}).status_code == 404
+    version = client.get("/api/library").json()["version"]
+    deleted = client.post("/api/library/point_up/delete", json={})
+    assert deleted.status_code == 200 and deleted.json()["version"] == version + 1
+    assert "point_up" not in {e["name"] for e in client.get("/api/library").json()["entries"]}
+    assert list((library_copy / ".backup").glob("point_up.v*.removed.yaml"))
+    last = [n for n, c in names.items() if c == "doubting" and n != "shrug"]
+    for name in last:  # down to the class default: it is the class's last motion and stays
+        assert client.post(f"/api/library/{name}/delete", json={}).status_code == 200
+    assert client.post("/api/library/shrug/delete", json={}).status_code == 409
+
+
+def test_a_refusal_names_a_time_and_keyframes_not_a_sample(client):
+    report = client.post("/api/studio/check", json={"keyframes": [REST, REACH_IN, REST]}).json()
+    reasons = [c["reason"] for c in report["levels"] if not c["ok"]]
+    assert reasons, "this draft should collide"
+    cited = re.compile(r"at \d+\.\d\d s \((at|between) K\d")
+    assert all("sample" not in r and cited.search(r) for r in reasons), reasons

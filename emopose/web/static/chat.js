@@ -1,6 +1,6 @@
 // The chat page: dialogue history with timed cues, the composer, and the live robot panel.
 import { api, connect, el, fillBadges } from "./common.js";
-import { markOutcome, markStroke, ReplyPlayer, showPlayed, turnBubble } from "./cues.js";
+import { markOutcome, markStroke, ReplyPlayer, setSourceWords, showFailure, showPlayed, turnBubble } from "./cues.js";
 import { RobotPanel } from "./robot.js";
 
 const $ = (id) => document.getElementById(id);
@@ -11,12 +11,46 @@ let pending = null;
 let replyOpen = false; // a streamed reply arrives sentence by sentence: its turns play one after another
 let libraryVersion = null;
 let plannerName = "";
+let planningTimer = null;
 
-// Narration planners (keyword, local, llm mode=narrate) speak the user's text as the robot's line; the page
-// says so once a turn shows it, and until then says who writes the reply.
-function showMode(narrated) {
-  $("mode-hint").textContent = narrated ? `narration: the robot says your text (planner ${plannerName})`
-    : `planner ${plannerName} writes the reply; a narration planner says your text as it is`;
+// Narration planners (keyword, local, llm mode=narrate) speak the user's text as the robot's line. The
+// server says which kind it runs (hello.narrates); a server that does not say is not guessed for: the
+// first turn shows it.
+// A failed call narrates whatever the planner: only a said turn the planner answered tells its kind.
+const tellsMode = (m) => m.type === "turn" && m.kind === "say" && m.source !== "call_failed";
+
+function showMode(narrates) {
+  $("mode-hint").textContent = narrates === true ? `narration: the robot says your text (planner ${plannerName})`
+    : narrates === false ? `planner ${plannerName} writes the robot's reply to you`
+    : `planner ${plannerName}: the first reply shows whether the robot answers or says your text`;
+}
+
+// The longest line the server takes (hello.limits.utterance_chars), enforced at the input with a count.
+function setInputLimit(limit) {
+  if (Number.isInteger(limit) && limit > 0) $("say-text").maxLength = limit;
+  showCount();
+}
+
+function showCount() {
+  const input = $("say-text"), used = Array.from(input.value).length;
+  $("say-count").textContent = `${used} / ${input.maxLength}`;
+  $("say-count").classList.toggle("late", used >= input.maxLength);
+}
+
+// "planning… 3.4 s": the pending bubble counts from when the server started the turn.
+function showPlanning(msg) {
+  clearPlanning();
+  const started = performance.now() - Math.max(0, (msg.now ?? msg.server_now) - msg.server_now) * 1000;
+  pending = el("div", { class: "bubble robot pending", text: "planning…" });
+  const tick = () => { pending.textContent = `planning… ${((performance.now() - started) / 1000).toFixed(1)} s`; };
+  tick();
+  planningTimer = setInterval(tick, 100);
+  history.append(pending);
+}
+
+function clearPlanning() {
+  clearInterval(planningTimer);
+  if (pending) { pending.remove(); pending = null; }
 }
 
 function showError(message) {
@@ -33,14 +67,14 @@ function userBubble(text, gesture = false) {
 }
 
 function addTurn(turn, live) {
-  if (pending) { pending.remove(); pending = null; }
+  clearPlanning();
   if (turn.kind !== "say") history.append(userBubble(`▶ perform ${turn.cues[0]?.resolved ?? ""} (i${turn.cues[0]?.intensity ?? 3})`, true));
   else if (!history.lastElementChild?.matches(`.bubble.user[data-utterance]`)) history.append(userBubble(turn.utterance));
   history.querySelectorAll(".bubble.user[data-utterance]").forEach((n) => n.removeAttribute("data-utterance"));
   const bubble = turnBubble(turn);
   history.append(bubble);
   if (live) {
-    if (!replyOpen) { players.forEach((p) => p.cancel()); players = []; } // a new reply cut the previous one
+    if (!replyOpen) { players.forEach((p) => p.cancel("cut off by the next reply")); players = []; }
     players.push(new ReplyPlayer(bubble, turn)); // a later sentence starts at its own speech start
     replyOpen = turn.kind === "say";
   } else showPlayed(bubble);
@@ -56,21 +90,31 @@ function onMessage(msg) {
       $("mic").classList.toggle("hidden", !msg.asr);
       $("attach-wrap").classList.toggle("hidden", !msg.channels.camera);
       history.replaceChildren();
+      setSourceWords(msg.sources);
       msg.log.filter((m) => m.type === "turn").forEach((t) => addTurn(t, false)); // outcomes are in the turns
+      msg.log.filter((m) => m.type === "planner_failed").forEach(onFailure);
       plannerName = msg.planner;
-      showMode(msg.log.some((m) => m.type === "turn" && m.narrated));
+      showMode(msg.narrates ?? msg.log.filter(tellsMode).map((t) => t.narrated).pop());
+      setInputLimit(msg.limits?.utterance_chars);
       loadMotions();
       break;
     case "turn_started":
       replyOpen = false;
       history.append(userBubble(msg.utterance));
       history.lastElementChild.setAttribute("data-utterance", ""); // addTurn will not repeat it
-      pending = el("div", { class: "bubble robot pending", text: "planning…" });
-      history.append(pending);
+      showPlanning(msg);
       scrollDown();
       break;
-    case "turn": addTurn(msg, true); if (msg.narrated) showMode(true); break;
-    case "interrupted": players.forEach((p) => p.cancel()); break;
+    case "turn": addTurn(msg, true); if (tellsMode(msg)) showMode(msg.narrated); break;
+    case "interrupted":
+      players.forEach((p) => p.cancel("interrupted"));
+      $("interrupt-note").textContent = "interrupted: the queue is cleared";
+      break;
+    case "planner_failed": onFailure(msg); break;
+    case "reply_stopped":
+      clearPlanning();
+      if (msg.error) showError(`the reply stopped: ${msg.error}`);
+      break;
     case "cue_outcome": {
       const bubble = history.querySelector(`.bubble.robot[data-turn="${msg.turn_id}"]`);
       if (bubble) markOutcome(bubble, msg.k, msg.outcome);
@@ -86,8 +130,13 @@ function onMessage(msg) {
       robot.update(msg);
       if (msg.library_version !== libraryVersion) { libraryVersion = msg.library_version; loadMotions(); }
       break;
-    case "error": showError(msg.message); if (pending) { pending.remove(); pending = null; } break;
+    case "error": showError(msg.message); clearPlanning(); break;
   }
+}
+
+function onFailure(msg) {
+  const bubble = history.querySelector(`.bubble.robot[data-turn="${msg.turn_id}"]`);
+  if (bubble) showFailure(bubble, msg.banner);
 }
 
 async function loadMotions(select) {
@@ -103,20 +152,38 @@ async function loadMotions(select) {
 const socket = connect({
   message: onMessage,
   frame: (tag, blob) => robot.frame(tag, blob),
-  status: (up) => { $("connection").textContent = up ? "live" : "reconnecting…"; },
+  status: showConnection,
 });
+
+// Disconnected: said at the top of the conversation, on the view, and on every action that cannot go out.
+function showConnection(up) {
+  $("connection").textContent = up ? "live" : "disconnected: reconnecting…";
+  $("connection").classList.toggle("late", !up);
+  $("offline").classList.toggle("hidden", up);
+  robot.live(up);
+  if (up) $("interrupt-note").textContent = "";
+}
+
+const notSent = (what) => showError(`${what} not sent: the page is disconnected (reconnecting…)`);
 
 $("say-form").addEventListener("submit", (event) => {
   event.preventDefault();
   const text = $("say-text").value.trim();
   if (!text) return;
-  socket.send({ type: "say", text, attach_camera: $("attach").checked });
+  if (!socket.send({ type: "say", text, attach_camera: $("attach").checked })) { notSent("your line was"); return; }
   $("say-text").value = "";
+  showCount();
 });
+$("say-text").addEventListener("input", showCount);
 $("gesture-go").addEventListener("click", () => {
-  socket.send({ type: "gesture", name: $("gesture-name").value, intensity: Number($("gesture-intensity").value) });
+  const sent = socket.send({ type: "gesture", name: $("gesture-name").value,
+    intensity: Number($("gesture-intensity").value) });
+  if (!sent) notSent("the gesture was");
 });
-$("interrupt").addEventListener("click", () => socket.send({ type: "interrupt" }));
+$("interrupt").addEventListener("click", () => {
+  const sent = socket.send({ type: "interrupt" });
+  $("interrupt-note").textContent = sent ? "interrupt sent…" : "not connected: the interrupt was not sent";
+});
 
 // Microphone (only shown when the server has an ASR): record while held, send on release. getUserMedia
 // resolves only after the permission prompt, so a release that comes first stops the take as it starts

@@ -38,6 +38,27 @@ export function el(tag, props = {}, ...children) {
   return node;
 }
 
+// Server clock (session seconds) -> this page's wall clock; the offset is learnt from the live state, and
+// times shown before it is known are filled in then.
+let clockOffset = null;
+
+function fillTime(node) {
+  if (clockOffset === null) return;
+  const at = new Date((Number(node.dataset.t) + clockOffset) * 1000);
+  node.textContent = at.toLocaleTimeString([], { hour12: false });
+}
+
+export function syncClock(serverNow) {
+  clockOffset = Date.now() / 1000 - serverNow;
+  document.querySelectorAll("time[data-t]:empty").forEach(fillTime);
+}
+
+export function clockTime(serverTime) {
+  const node = el("time", { "data-t": serverTime });
+  fillTime(node);
+  return node;
+}
+
 // One WebSocket with automatic reconnection; binary messages are frames: 1 tag byte + JPEG.
 export function connect({ message, frame, status }) {
   let socket = null;
@@ -54,7 +75,14 @@ export function connect({ message, frame, status }) {
     };
   };
   open();
-  return { send: (msg) => socket && socket.readyState === 1 && socket.send(JSON.stringify(msg)) };
+  // true when the message went out: a closed socket sends nothing, and the caller says so
+  return {
+    send: (msg) => {
+      if (!socket || socket.readyState !== WebSocket.OPEN) return false;
+      socket.send(JSON.stringify(msg));
+      return true;
+    },
+  };
 }
 
 export function fillBadges(container, info) {

@@ -2,19 +2,23 @@
 // live highlighting that lights a trigger up when its stroke lands (or at its release time in the
 // paper's modes), relative to speech start. A cue the
 // sequencer did not perform (rejected, dropped) is marked with the reason and never lights up.
-import { CLASS_COLORS, el } from "./common.js";
+import { CLASS_COLORS, clockTime, el } from "./common.js";
 
+// The server's character offsets count code points (Python strings); JavaScript strings index UTF-16
+// units, in which an emoji counts twice. Slicing the code-point array keeps the marks on their words.
 function replyNode(reply, cues) {
+  const chars = Array.from(reply), text = (a, b) => chars.slice(a, b).join("");
   const spans = cues.filter((c) => c.char_start !== null).sort((a, b) => a.char_start - b.char_start);
   const node = el("div", { class: "reply" });
   let at = 0;
   for (const cue of spans) {
     if (cue.char_start < at) continue; // overlapping triggers: the first one keeps the mark
-    node.append(reply.slice(at, cue.char_start));
-    node.append(el("mark", { "data-k": cue.k, style: `--cue:${CLASS_COLORS[cue.class]}`, text: reply.slice(cue.char_start, cue.char_end) }));
+    node.append(text(at, cue.char_start));
+    node.append(el("mark", { "data-k": cue.k, style: `--cue:${CLASS_COLORS[cue.class]}`,
+      text: text(cue.char_start, cue.char_end) }));
     at = cue.char_end;
   }
-  node.append(reply.slice(at));
+  node.append(text(at));
   return node;
 }
 
@@ -25,7 +29,7 @@ function cueNode(cue) {
     el("span", { class: "muted", text: cue.class }), "→",
     el("span", { class: "name", text: cue.resolved }),
     el("span", { class: "muted", text: `${rule}${asked} · i${cue.intensity}` }),
-    cue.trigger ? el("span", { text: `“${cue.trigger}”` }) : null,
+    cue.trigger ? el("span", { class: "trigger", text: `“${cue.trigger}”` }) : null,
     el("span", { class: "time", text: cueTime(cue) }));
 }
 
@@ -55,16 +59,44 @@ export function markOutcome(bubble, k, outcome) {
   }
 }
 
+// Where a turn's gestures came from, in the server's words (hello.sources: each plan source for a visitor).
 const ORIGIN = { gesture: "named gesture", draft: "Pose Studio draft" };
+let sourceWords = {};
+export function setSourceWords(words) { sourceWords = words || {}; }
+const origin = (turn) => ORIGIN[turn.kind] ?? sourceWords[turn.source] ?? turn.source;
+
+// Whether the dialogue so far reached the planner (history_messages) and, when it says, whether it read it.
+function contextWords(turn) {
+  const n = turn.history_messages;
+  if (turn.kind !== "say" || n === undefined) return null;
+  if (!n) return "no earlier messages";
+  const messages = `${n} earlier message${n > 1 ? "s" : ""}`;
+  if (turn.history_used === false) return `${messages} set aside (unrelated)`;
+  return turn.history_used ? `read with ${messages}` : `${messages} given to the planner`;
+}
+
+// The planner call failed for good: a banner with the cause (the server's planner_failed message, when it
+// comes, puts its own words there: showFailure).
+function failureBanner(turn) {
+  return el("div", { class: "call-failed", role: "alert" }, el("b", { text: "Planner call failed: " }),
+    el("span", { text: turn.planner_error || "no cause given" }));
+}
+
+export function showFailure(bubble, banner) {
+  bubble.querySelector(".call-failed")?.replaceChildren(el("b", { text: "Planner call failed. " }), banner);
+}
 
 export function turnBubble(turn) {
   const bar = el("div", { class: "speechbar" }, el("div"));
-  const meta = `${ORIGIN[turn.kind] ?? `plan: ${turn.source}`} · speech ${turn.speech.duration_s.toFixed(1)} s`
-    + ` · planner ${(turn.planner_latency_s * 1000).toFixed(0)} ms · library v${turn.library_version}`;
-  const bubble = el("div", { class: "bubble robot", "data-turn": turn.turn_id },
-    turn.narrated ? el("div", { class: "narrated", text: "narration: the robot says your text" }) : null,
+  const failed = turn.source === "call_failed";
+  const meta = [origin(turn), contextWords(turn), `speech ${turn.speech.duration_s.toFixed(1)} s`,
+    `planner ${(turn.planner_latency_s * 1000).toFixed(0)} ms`, `library v${turn.library_version}`, ""]
+    .filter((part) => part !== null).join(" · ");
+  const bubble = el("div", { class: `bubble robot${failed ? " failed" : ""}`, "data-turn": turn.turn_id },
+    failed ? failureBanner(turn) : null,
+    turn.narrated && !failed ? el("div", { class: "narrated", text: "narration: the robot says your text" }) : null,
     turn.reply ? replyNode(turn.reply, turn.cues) : null,
-    el("div", { class: "cues" }, turn.cues.map(cueNode)), bar, el("div", { class: "meta", text: meta }));
+    el("div", { class: "cues" }, turn.cues.map(cueNode)), bar, el("div", { class: "meta" }, meta, clockTime(turn.server_now)));
   turn.cues.forEach((cue) => cue.outcome && markOutcome(bubble, cue.k, cue.outcome));
   bubble.cueData = turn.cues;
   return bubble;
@@ -111,12 +143,14 @@ export class ReplyPlayer {
     requestAnimationFrame(() => this.tick());
   }
 
-  cancel() {
+  // Stopped before its end: `why` is shown on the bubble ("cut off by the next reply", "interrupted").
+  cancel(why) {
     if (this.done) return;
     this.done = true;
     clearTimeout(this.timer);
     if (this.audio) this.audio.pause();
     this.bubble.querySelectorAll(".cue:not(.fired):not(.refused)").forEach((n) => n.classList.add("cancelled"));
+    this.bubble.querySelector(".meta").before(el("div", { class: "cut-off", text: why }));
   }
 }
 

@@ -1,13 +1,18 @@
 // Pose Studio: author a library motion, see the trajectory the robot would run and its checks,
 // preview it in MuJoCo, perform the draft on the robot, and save it into the live library.
-import { api, drawStick, el, fillBadges } from "./common.js";
-import { drawCurves } from "./studio_plot.js";
+import { api, el, fillBadges } from "./common.js";
+import { DraftHistory, wireUndo } from "./studio_history.js";
+import { wireLibraryActions } from "./studio_library.js";
+import { preview } from "./studio_preview.js";
 
 const $ = (id) => document.getElementById(id);
 const MIRROR = [1, -1, -1, 1, -1, 1, -1]; // q_right = MIRROR * q_left (emopose/robot/kinematics.py)
 const NAME_RE = /^[a-z][a-z0-9_]{1,63}$/;
 const S = { library: null, keyframes: [], stroke: null, selected: 0, report: null, frames: null, t: 0, playing: false };
 let checkTimer = null, checkSeq = 0;
+const edits = new DraftHistory();
+const DRAFT = "__draft__"; // the Motion menu's entry for the draft on screen
+const { renderChecks, drawAll, play, showPreviewFrames, renderPreview } = preview(S, draft, () => updateSaveButton());
 
 const round = (v) => Math.round(v * 1000) / 1000;
 const neutral = () => [...S.library.neutral_pose];
@@ -15,13 +20,51 @@ const neutral = () => [...S.library.neutral_pose];
 async function loadLibrary(keep) {
   S.library = await api("/api/library");
   const open = $("open-name");
-  open.replaceChildren(...S.library.classes.map((cls) => el("optgroup", { label: cls },
-    S.library.entries.filter((e) => e.class === cls).map((e) => el("option", { value: e.name, text: `${e.name} (${e.keyframes})` })))));
-  if (keep) open.value = keep;
+  open.replaceChildren(el("option", { value: DRAFT, id: "draft-option" }),
+    ...S.library.classes.map((cls) => el("optgroup", { label: cls },
+      S.library.entries.filter((e) => e.class === cls).map((e) => el("option", { value: e.name, text: `${e.name} (${e.keyframes})` })))));
+  if (keep) S.opened = keep;
+  showDraftInMenu();
   document.querySelector("#library-badge b")?.replaceChildren(String(S.library.version));
 }
 
-function setMotion(entry) {
+// What the page edits: everything a save writes. Undo/redo and "unsaved changes" compare these.
+function snapshot() {
+  return { name: $("name").value, class: $("class").value, description: $("description").value,
+    motion_type: $("motion-type").value, explicit: $("explicit").checked, duration: $("duration").value,
+    keyframes: S.keyframes, stroke: S.stroke };
+}
+
+function restore(state) {
+  $("name").value = state.name; $("class").value = state.class; $("description").value = state.description;
+  $("motion-type").value = state.motion_type; $("explicit").checked = state.explicit;
+  $("duration").value = state.duration;
+  S.keyframes = state.keyframes; S.stroke = state.stroke;
+  S.selected = Math.min(S.selected, S.keyframes.length - 1);
+  refresh();
+}
+
+const unsaved = () => edits.dirty(snapshot());
+
+// The Motion menu shows what is on screen: the opened motion while unchanged, else the draft entry.
+function showDraftInMenu() {
+  const option = $("draft-option"), open = $("open-name");
+  if (!option) return;
+  const name = $("name").value || "new motion";
+  option.textContent = `✎ editing: ${name}${unsaved() ? " (unsaved changes)" : ""}`;
+  open.value = S.opened && !unsaved() && S.library.entries.some((e) => e.name === S.opened) ? S.opened : DRAFT;
+  $("undo").disabled = !edits.canUndo; $("redo").disabled = !edits.canRedo;
+  $("rename").disabled = $("delete").disabled = !S.opened;
+}
+
+// After each committed edit: a step for undo, and the menu's "unsaved" mark.
+function committed() { edits.commit(snapshot()); showDraftInMenu(); }
+
+function leaveDraft() { return !unsaved() || confirm("The draft on screen has unsaved changes. Discard them?"); }
+
+function setMotion(entry, opened = null) {
+  for (const id of ["save-result", "perform-result", "library-result", "joint-note"]) $(id).replaceChildren();
+  S.opened = opened;
   $("name").value = entry.name; $("class").value = entry.class; $("description").value = entry.description;
   $("motion-type").value = entry.motion_type;
   $("explicit").checked = entry.duration !== null && entry.duration !== undefined;
@@ -31,6 +74,7 @@ function setMotion(entry) {
   S.selected = Math.min(1, S.keyframes.length - 1);
   S.frames = null; showPreviewFrames();
   refresh();
+  edits.reset(snapshot()); showDraftInMenu();
   setTimeout(renderPreview, 200); // one MuJoCo preview per opened motion; edits re-render on request
 }
 
@@ -62,9 +106,10 @@ function refresh() {
 
 function renderKeyframes() {
   const list = $("keyframes");
+  const arm = (kf, side) => `${side} ${kf.slice(side === "L" ? 0 : 7, side === "L" ? 7 : 14).map((v) => v.toFixed(2)).join(" ")}`;
   list.replaceChildren(...S.keyframes.map((kf, k) => el("li", { class: k === S.selected ? "selected" : "", onclick: () => { S.selected = k; refresh(); } },
     el("span", { class: "k", text: `K${k}` }),
-    el("span", { class: "sum", text: kf.map((v) => v.toFixed(2)).join(" ") }),
+    el("span", { class: "sum" }, el("span", { text: arm(kf, "L") }), el("span", { text: arm(kf, "R") })),
     el("span", { class: "stroke-mark", text: strokeMark(k) }))));
   const pose = $("motion-type").value === "pose";
   $("kf-add").disabled = pose || S.keyframes.length >= 14;
@@ -81,9 +126,18 @@ function renderSliders() {
     const label = name.replace(/^(left|right)_/, "").replace(/_joint$/, "").replace("_", " ");
     const attrs = { min: lower[j], max: upper[j], step: 0.01, value: q[j], "aria-label": name };
     const range = el("input", { type: "range", ...attrs }), number = el("input", { type: "number", ...attrs });
-    const set = (v) => { q[j] = round(Math.min(upper[j], Math.max(lower[j], Number(v)))); range.value = q[j]; number.value = q[j]; refreshLight(); };
+    const set = (v) => { q[j] = round(Number(v)); range.value = q[j]; number.value = q[j]; refreshLight(); };
     range.addEventListener("input", () => set(range.value));
-    number.addEventListener("change", () => set(number.value));
+    range.addEventListener("change", committed);
+    // A typed value outside the joint's limits is refused, and said so; never clamped silently.
+    number.addEventListener("change", () => {
+      const v = Number(number.value), ok = number.value !== "" && v >= lower[j] && v <= upper[j];
+      number.classList.toggle("invalid", !ok);
+      $("joint-note").className = ok ? "" : "bad";
+      $("joint-note").textContent = ok ? "" : `${name}: ${number.value} rad is outside its limits `
+        + `${lower[j]} .. ${upper[j]} rad; not applied (K${S.selected} keeps ${q[j]})`;
+      if (ok) { set(v); committed(); } else number.value = q[j];
+    });
     box.append(el("span", { title: `${name}: ${lower[j]} .. ${upper[j]} rad`, text: label }), range, number);
   });
 }
@@ -138,93 +192,7 @@ async function check() {
   }
 }
 
-function renderChecks(r) {
-  const K = S.keyframes.length;
-  $("duration-rule").textContent = `default rule d = clip(0.3·(K−1), 1, 5) = clip(0.3·${K - 1}, 1, 5) = ${r.default_duration.toFixed(2)} s`
-    + (r.explicit_duration ? ` · overridden: ${r.duration.toFixed(2)} s` : " · used");
-  $("traj-meta").textContent = `${r.samples.length} samples · ${((r.samples.length - 1) * r.dt).toFixed(2)} s · intensity ${r.intensity}`;
-  $("check-limits").replaceChildren(r.keyframe_violations.length
-    ? el("span", { class: "pill bad", text: `outside: ${r.keyframe_violations.join(", ")}` }) : el("span", { class: "pill ok", text: "within limits" }));
-  $("check-levels").replaceChildren(...r.levels.map((c) => el("span", { class: `pill ${c.ok ? "ok" : "bad"}`,
-    title: c.reason || "", text: `i${c.intensity} ${c.ok ? "✓" : "✗"} ${(c.min_clearance_m * 100).toFixed(1)} cm` })));
-  $("check-speed").replaceChildren(r.stretch > 1.001
-    ? el("span", { class: "pill warn", text: `slowed ×${r.stretch.toFixed(2)} to respect joint speed limits` }) : el("span", { class: "pill ok", text: "within speed limits" }));
-  $("check-notes").replaceChildren(...r.problems.map((p) => el("li", { class: "bad", style: "color:var(--bad)", text: p })),
-    ...r.warnings.map((w) => el("li", { class: "warn", text: `warning: ${w}` })),
-    el("li", { class: "muted small", text: `checked: ${r.checked} (${r.check_ms.toFixed(0)} ms)` }));
-  $("verdict").replaceChildren(el("span", { class: `pill ${r.can_save ? "ok" : "bad"}`, text: r.can_save ? "ready to save" : "cannot save" }));
-  updateSaveButton();
-}
-
-function drawAll() {
-  const r = S.report;
-  if (!r) return;
-  drawCurves($("curves"), r, S.library.limits, S.selected, S.t);
-  const stick = r.stick[Math.min(r.stick.length - 1, Math.round(S.t / r.stick_dt))];
-  drawStick($("preview-stick"), stick);
-  const span = (r.samples.length - 1) * r.dt;
-  $("scrub").value = String(Math.round((1000 * S.t) / Math.max(span, 1e-6)));
-  if (S.frames && S.frames.frames.length) {
-    let best = 0;
-    S.frames.times.forEach((t, i) => { if (Math.abs(t - S.t) < Math.abs(S.frames.times[best] - S.t)) best = i; });
-    $("preview-img").src = S.frames.frames[best];
-  }
-}
-
-function play() {
-  const r = S.report;
-  if (!r) return;
-  const span = (r.samples.length - 1) * r.dt, start = performance.now() - S.t * 1000;
-  S.playing = true;
-  const step = () => {
-    if (!S.playing || S.report !== r) { S.playing = false; return; }
-    S.t = Math.min(span, (performance.now() - start) / 1000);
-    drawAll();
-    if (S.t < span) requestAnimationFrame(step); else S.playing = false;
-  };
-  requestAnimationFrame(step);
-}
-
-function showPreviewFrames() {
-  const has = S.frames && S.frames.frames.length;
-  $("preview-img").classList.toggle("hidden", !has);
-  $("preview-caption").textContent = !S.frames ? "not rendered yet"
-    : has ? `MuJoCo '${S.frames.camera}' · ${S.frames.frames.length} frames` : `stick figure only: ${S.frames.reason}`;
-}
-
-async function renderPreview() {
-  $("render").disabled = true; $("preview-caption").textContent = "rendering…";
-  try {
-    const request = { ...draft(), camera: $("camera").value };
-    S.frames = { ...(await api("/api/studio/preview", request)), key: JSON.stringify(draft()) };
-    showPreviewFrames(); S.t = 0; play();
-  } catch (error) { $("preview-caption").textContent = error.message; }
-  $("render").disabled = false;
-}
-
-async function save() {
-  const out = $("save-result");
-  try {
-    const saved = await api("/api/library", { name: $("name").value, class: $("class").value, description: $("description").value,
-      motion_type: $("motion-type").value, duration: draft().duration, stroke: S.stroke, keyframes: S.keyframes, overwrite: $("overwrite").checked });
-    out.className = "ok";
-    out.textContent = `saved ${saved.name} → ${saved.file}` + (saved.backup ? ` (backup ${saved.backup})` : "") + ` · library v${saved.version}: the planner and resolver see it now`;
-    await loadLibrary(saved.name); renderNameHint();
-  } catch (error) { out.className = "bad"; out.textContent = error.message; }
-}
-
-// Runs the keyframes on screen (saved or not) through the same checks as any gesture; the library is unchanged.
-async function perform() {
-  const out = $("perform-result");
-  try {
-    const turn = await api("/api/studio/perform", { ...draft(), class: $("class").value });
-    out.className = "ok";
-    out.textContent = `performing the draft on screen at intensity ${turn.cues[0].intensity}`
-      + ` (as ${turn.cues[0].resolved}; the library is unchanged)`;
-  } catch (error) { out.className = "bad"; out.textContent = error.message; }
-}
-
-function edit(fn) { fn(); refresh(); }
+function edit(fn) { fn(); refresh(); committed(); }
 const kf = () => S.keyframes[S.selected];
 $("kf-add").onclick = () => edit(() => { S.keyframes.splice(S.selected + 1, 0, [...kf()]); S.selected += 1; });
 $("kf-remove").onclick = () => edit(() => { S.keyframes.splice(S.selected, 1); S.selected = Math.max(0, S.selected - 1); });
@@ -237,21 +205,39 @@ $("motion-type").onchange = () => edit(() => {
   if ($("motion-type").value === "pose") { S.keyframes = [kf()]; S.selected = 0; }
   else if (S.keyframes.length < 3) { S.keyframes = [neutral(), kf(), neutral()]; S.selected = 1; }
 });
-for (const id of ["explicit", "duration", "intensity"]) $(id).onchange = refresh;
+for (const id of ["explicit", "duration", "motion-type", "class"]) $(id).addEventListener("change", committed);
+for (const id of ["explicit", "duration", "intensity"]) $(id).addEventListener("change", refresh);
 const interior = () => Math.min(Math.max(S.selected, 1), S.keyframes.length - 2);
 $("stroke-start").onclick = () => edit(() => { const k = interior(); S.stroke = [k, Math.max(k, strokeSpan()?.[1] ?? k)]; });
 $("stroke-end").onclick = () => edit(() => { const k = interior(); S.stroke = [Math.min(k, strokeSpan()?.[0] ?? k), k]; });
 $("stroke-auto").onclick = () => edit(() => { S.stroke = null; });
-$("name").oninput = renderNameHint;
+$("name").oninput = () => { renderNameHint(); showDraftInMenu(); };
 $("overwrite").onchange = updateSaveButton;
 $("description").oninput = updateSaveButton;
-$("open").onclick = async () => setMotion(await api(`/api/library/${encodeURIComponent($("open-name").value)}`));
-$("new").onclick = newMotion;
+for (const id of ["name", "description"]) $(id).addEventListener("change", committed);
+$("open").onclick = async () => {
+  const name = $("open-name").value;
+  if (name === DRAFT || !leaveDraft()) return;
+  setMotion(await api(`/api/library/${encodeURIComponent(name)}`), name);
+};
+$("new").onclick = () => leaveDraft() && newMotion();
+wireUndo(edits, (state) => { if (state) restore(state); showDraftInMenu(); });
+// Leaving (a link, reload, closing the tab) with unsaved changes: the browser asks first.
+window.addEventListener("beforeunload", (e) => { if (unsaved()) e.preventDefault(); });
 $("render").onclick = renderPreview;
 $("play").onclick = () => { S.t = 0; S.playing = false; requestAnimationFrame(play); };
 $("scrub").oninput = () => { S.playing = false; const r = S.report; if (r) { S.t = (Number($("scrub").value) / 1000) * (r.samples.length - 1) * r.dt; drawAll(); } };
-$("save").onclick = save;
-$("perform").onclick = perform;
+wireLibraryActions({
+  draft,
+  motion: () => ({ name: $("name").value, class: $("class").value, description: $("description").value,
+    motion_type: $("motion-type").value, duration: draft().duration, stroke: S.stroke, keyframes: S.keyframes }),
+  opened: () => S.opened,
+  after: async (name, saved) => {
+    S.opened = name;
+    if (saved) edits.saved(snapshot());
+    await loadLibrary(name); renderNameHint();
+  },
+});
 window.addEventListener("resize", drawAll);
 
 (async () => {
