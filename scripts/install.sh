@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One-command install on Debian 12 (root or sudo): system libraries, the CPU build of torch, Cyclone DDS
-# 0.10.2 for the G1 backend, and EmoPose itself in editable mode with every extra.
+# 0.10.2 for the G1 backend, and EmoPose itself in editable mode with every extra (piper: GPL-3.0-or-later).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -15,5 +15,6 @@ $SUDO apt-get install -y -qq --no-install-recommends \
 
 python -m pip install -q torch==2.13.0   # the local CPU build; a looser pin pulls GBs of CUDA wheels
 bash .ci/install_cyclonedds.sh            # builds cyclonedds==0.10.2 against Debian's C library
-python -m pip install -q -e ".[embed,web,g1,dev]"
+# voice: local speech recognition and voice activity (MIT); piper: the neural voice, GPL-3.0-or-later
+python -m pip install -q -e ".[embed,web,g1,dev,voice,piper]"
 echo "EmoPose installed. Try: python -m emopose +experiment=bench_hard"

@@ -1,4 +1,5 @@
-"""Speech recognition for the user's side of a turn: asr=none (typed text) or asr=litellm (any model).
+"""Speech recognition for the user's side of a turn: asr=none (typed text), asr=litellm (any model);
+asr=whisper (local, emopose/speech/whisper_asr.py) offers the same interface.
 
 Both offer `utterance(text=None, audio=None) -> str`: typed text passes through unchanged; an audio file
 is transcribed (asr=litellm) or refused with the fix (asr=none). litellm.transcription posts the file
@@ -22,6 +23,17 @@ AUDIO_SUFFIXES = (".wav", ".mp3", ".m4a", ".ogg", ".oga", ".flac", ".webm", ".mp
 
 class ASRError(RuntimeError):
     """An utterance could not be obtained; the message names the config key or file to fix."""
+
+
+def existing_audio_file(audio: str | Path) -> Path:
+    """The path of an audio file that exists and has a suffix we decode, or ASRError saying which."""
+    path = Path(audio)
+    if not path.is_file():
+        raise ASRError(f"audio file {path} does not exist")
+    if path.suffix.lower() not in AUDIO_SUFFIXES:
+        raise ASRError(f"audio file {path.name} has suffix {path.suffix!r}; "
+                       f"use one of {', '.join(AUDIO_SUFFIXES)}")
+    return path
 
 
 class Recognizer(ABC):
@@ -48,7 +60,8 @@ class TypedText(Recognizer):
     accepts_audio = False
 
     def transcribe(self, audio: str | Path) -> str:
-        raise ASRError(f"asr=none cannot transcribe {audio}: type the utterance, or run with asr=litellm")
+        raise ASRError(f"asr=none cannot transcribe {audio}: type the utterance, or run with "
+                       "asr=whisper (local) or asr=litellm")
 
 
 class LitellmTranscriber(Recognizer):
@@ -66,12 +79,7 @@ class LitellmTranscriber(Recognizer):
         self.last_latency_s: float | None = None
 
     def transcribe(self, audio: str | Path) -> str:
-        path = Path(audio)
-        if not path.is_file():
-            raise ASRError(f"audio file {path} does not exist")
-        if path.suffix.lower() not in AUDIO_SUFFIXES:
-            raise ASRError(f"audio file {path} has suffix {path.suffix!r}; "
-                           f"use one of {', '.join(AUDIO_SUFFIXES)}")
+        path = existing_audio_file(audio)
         litellm = litellm_module()  # heavy import, only when audio is transcribed
         optional = {k: v for k, v in (("language", self.language), ("prompt", self.prompt)) if v}
         started = time.perf_counter()
