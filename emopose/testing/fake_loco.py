@@ -69,13 +69,7 @@ class FakeLoco:
             ]
 
     def _serve(self, stop: threading.Event) -> None:
-        while not stop.is_set():
-            try:
-                requests = self._requests.take_typed(timeout_s=0.05)
-            except Exception:  # noqa: BLE001 - the session was closed under us: just stop
-                return
-            for request in requests:
-                self._answer(request)
+        answer_requests(self._requests, stop, self._answer)
 
     def _answer(self, request: Request_) -> None:
         identity = request.header.identity
@@ -118,3 +112,14 @@ class FakeLoco:
         except (KeyError, TypeError, ValueError):
             return RPC_ERR_SERVER_API_PARAMETER, ""
         return RPC_ERR_SERVER_API_NOT_IMPL, ""
+
+
+def answer_requests(requests, stop: threading.Event, answer: Callable[[Request_], None]) -> None:
+    """A fake service's loop: answer each request read from `requests` until stop (or its session closes)."""
+    while not stop.is_set():
+        try:
+            batch = requests.take_typed(timeout_s=0.05)
+        except Exception:  # noqa: BLE001 - the session was closed under us: just stop
+            return
+        for request in batch:
+            answer(request)

@@ -5,7 +5,8 @@
 Publishes rt/lowstate (500 Hz, valid CRC); takes rt/arm_sdk, ignores (and counts) commands with a
 bad CRC, and moves each commanded arm joint toward  w * q_cmd + (1 - w) * q_firmware  with a
 first-order lag (tau 0.05 s), w = motor_cmd[29].q (w = 0: the firmware holds its own pose).
-Answers the loco RPCs (see fake_loco.py). --log writes one JSON line per received arm command
+Answers the loco RPCs (see fake_loco.py) and the voice RPCs, and streams a WAV as its microphone
+(see fake_voice.py). --log writes one JSON line per received arm command
 (q, weight, modes, gains, crc_ok; t when taken, sent_ns when the sender wrote it: the
 batch-free send time), per loco request, and a final summary. Prints READY when up.
 """
@@ -30,9 +31,27 @@ from emopose.backends.g1.hg_types import LowCmd_, LowState_
 from emopose.execution.worker import Worker
 from emopose.robot.g1_spec import NUM_MOTORS, WEIGHT_MOTOR
 from emopose.testing.fake_loco import FakeLoco
+from emopose.testing.fake_voice import FakeVoice, add_voice_args
 
 DEFAULT_ARM_POSE = [0.3, 0.25, 0.0, 0.9, 0.0, 0.1, 0.0, 0.3, -0.25, 0.0, 0.9, 0.0, 0.1, 0.0]
 _SDK_MOTORS = slice(12, 29)  # waist + arms: what arm_sdk may command
+
+
+def quaternion_of(rpy: list[float]) -> tuple[float, float, float, float]:
+    """(w, x, y, z) of roll, pitch, yaw applied as Rz(yaw) Ry(pitch) Rx(roll)."""
+    cr, sr, cp, sp, cy, sy = (f(a / 2) for a in rpy for f in (math.cos, math.sin))
+    return (cr * cp * cy + sr * sp * sy, sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy)
+
+
+def floats(count: int):
+    """argparse type: `count` comma-separated numbers."""
+    def parse(text: str) -> list[float]:
+        values = [float(v) for v in text.split(",")]
+        if len(values) != count:
+            raise argparse.ArgumentTypeError(f"needs {count} comma-separated values")
+        return values
+    return parse
 
 
 class FakeG1:
@@ -50,8 +69,10 @@ class FakeG1:
         )
         forced = dict(tuple(int(v) for v in spec.split(":")) for spec in args.fail_api)
         self.loco = FakeLoco(self.session, args.loco_service, self.log, forced)
+        self.voice = FakeVoice(self.session, args, self.log, forced)
         self.firmware_q = np.zeros(NUM_MOTORS)
         self.firmware_q[15:29] = args.arm_pose
+        self.firmware_q[12:15] = args.waist
         self.q = self.firmware_q.copy()
         self._cmd_q = self.q.copy()
         self._cmd_mode = np.zeros(NUM_MOTORS, dtype=bool)
@@ -62,7 +83,8 @@ class FakeG1:
         self._commands = Worker("fake-arm-sdk", self._take_commands, join_timeout_s=1.0)
         self._record = wire.new_lowstate()
         self._record["version"] = (1, 0)
-        self._record["imu_state"]["quaternion"] = (1.0, 0.0, 0.0, 0.0)
+        self._record["imu_state"]["quaternion"] = quaternion_of(args.imu_rpy)
+        self._record["imu_state"]["rpy"] = args.imu_rpy
         self._record["imu_state"]["accelerometer"] = (0.0, 0.0, 9.81)
 
     def log(self, entry: dict) -> None:
@@ -122,6 +144,7 @@ class FakeG1:
     def run(self) -> None:
         self._commands.start()
         self.loco.start()
+        self.voice.start()
         period = 1.0 / self.args.lowstate_hz
         start = last = time.monotonic()
         deadline = start
@@ -148,6 +171,7 @@ class FakeG1:
         self._stop.set()
         self._commands.stop()
         self.loco.stop()
+        self.voice.stop()
         self.log(
             {
                 "kind": "summary",
@@ -157,6 +181,7 @@ class FakeG1:
                 "odom": self.loco.odom,
                 "fsm_id": self.loco.fsm_id,
                 "arm_q": self.q[15:29].tolist(),
+                **self.voice.summary(),
             }
         )
         self.session.close()
@@ -182,10 +207,14 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument("--tau", type=float, default=0.05, help="joint response time constant, s")
     p.add_argument(
         "--arm-pose",
-        type=lambda s: [float(v) for v in s.split(",")],
+        type=floats(14),
         default=DEFAULT_ARM_POSE,
         help="14 comma-separated joint angles the firmware holds (library order)",
     )
+    p.add_argument("--waist", type=floats(3), default=[0.0, 0.0, 0.0],
+                   help="waist yaw,roll,pitch the firmware holds (rad)")
+    p.add_argument("--imu-rpy", type=floats(3), default=[0.0, 0.0, 0.0],
+                   help="the pelvis IMU's roll,pitch,yaw (rad)")
     p.add_argument(
         "--bad-lowstate-crc", action="store_true", help="publish lowstate with a wrong CRC"
     )
@@ -195,12 +224,10 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         action="append",
         default=[],
         metavar="API:CODE",
-        help="answer this loco api id with this non-zero status (repeatable)",
+        help="answer this loco or voice api id with this non-zero status (repeatable)",
     )
-    args = p.parse_args(argv)
-    if len(args.arm_pose) != 14:
-        p.error("--arm-pose needs 14 values")
-    return args
+    add_voice_args(p)
+    return p.parse_args(argv)
 
 
 def main(argv: list[str] | None = None) -> int:
