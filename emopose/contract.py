@@ -30,6 +30,10 @@ MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
 # The longest text of a record (the parser cuts a trigger or variant to it at a word), and the piece a
 # tour line is planned in (whole sentences under it); a reply keeps more (stages/parse.py MAX_SPOKEN_CHARS).
 MAX_REPLY_CHARS = 200
+# What a record's trigger is (README "The planner's contract"; the schema's description says it to a model)
+TRIGGER_RULE = ("the words the gesture belongs to (its lexical affiliate: the place pointed at, the stressed "
+                "words, the yes, no or greeting itself), 1-6 words copied exactly from the reply; its first "
+                "word is where the stroke lands, so it starts there, not at the clause around it")
 
 
 class EventKind(StrEnum):
@@ -105,7 +109,8 @@ def plan_schema(variants: Sequence[str], max_gestures: int) -> dict:
     record = create_model(
         "GestureRecord", __config__=strict, __doc__=GestureRecord.__doc__,
         cls=(GestureClass, Field(alias="class")), variant=(Literal[tuple(variants)], ...),
-        intensity=(int, Field(ge=1, le=5)), trigger=(str, ...), confidence=(float, Field(ge=0.0, le=1.0)))
+        intensity=(int, Field(ge=1, le=5)), trigger=(str, Field(description=TRIGGER_RULE)),
+        confidence=(float, Field(ge=0.0, le=1.0)))
     answer = create_model("GesturePlan", __config__=strict, reply=(str, ...),
                           gestures=(list[record], Field(min_length=1, max_length=max_gestures)))
     return answer.model_json_schema(by_alias=True)

@@ -4,6 +4,9 @@ Each item's planned records (class, trigger, variant, in order) are scored again
 labels, anchors and variants with emopose.bench.sequence_metrics (definitions there). Rates are per
 pass, reported as mean and sample SD over passes; segmentation counts are pooled over passes.
 Annotated variants are checked against the live library before planning (check_variants).
+With tts=espeak (the experiment's default) it also reports where the triggers start against the gold
+anchors in speech time (emopose.sync.affiliate): the share of anchors whose gesture's trigger onset is
+within 200 ms of the anchor's, and the signed offsets, pooled over passes.
 """
 
 from __future__ import annotations
@@ -27,6 +30,8 @@ from emopose.jobs.suite_planning import (
 from emopose.planners.base import PlanRequest
 from emopose.resources import Run
 from emopose.results import JobOutput
+from emopose.speech.espeak import EspeakSynthesizer
+from emopose.sync.affiliate import anchor_offsets, offset_summary
 
 COUNT_KEYS = ("over", "under", "failed")
 
@@ -62,11 +67,16 @@ class SequenceSuiteJob:
         requests = [PlanRequest(utterance=i.text) for i in items]
         per_pass, predictions, planned_all = [], [], []
         started = time.perf_counter()
+        offsets: list[float | None] = []
         for p in range(passes):
             planned = plan_suite(planner, requests, f"{planner.name} sequence pass {p + 1}/{passes}",
                                  self.chunk_size, self.progress)
             planned_all.extend(planned)
             preds = [as_prediction(o) for o in planned]
+            if isinstance(res.synthesizer, EspeakSynthesizer):
+                offsets += [o for item, pred in zip(items, preds)
+                            for o in anchor_offsets(item.text, item.spans, pred.triggers,
+                                                    res.synthesizer.word_events(item.text))]
             per_pass.append(suite_scores(items, preds))
             for item, pred, outcome in zip(items, preds, planned):
                 predictions.append({"id": item.id, "labels": list(item.labels),
@@ -84,11 +94,25 @@ class SequenceSuiteJob:
             "segmentation": {f"{k}_total": sum(s[k] for s in per_pass) for k in COUNT_KEYS}
             | {f"{k}_per_pass": [s[k] for s in per_pass] for k in COUNT_KEYS},
             "per_pass": per_pass,
+            "anchor_onsets": offset_summary(offsets) if offsets else None,
             **run_summary(planned_all, started, self.max_fallback_share),
             "predictions": predictions,
         }
         seg = results["segmentation"]
         markdown = comparison_markdown([results]) + (
             f"\nPooled over {passes} pass(es) x {len(items)} plans: {seg['over_total']} over-segmented, "
-            f"{seg['under_total']} under-segmented, {seg['failed_total']} failed.\n")
+            f"{seg['under_total']} under-segmented, {seg['failed_total']} failed.\n"
+            + onset_markdown(results["anchor_onsets"]))
         return suite_output(results, markdown)
+
+
+def onset_markdown(summary: dict | None) -> str:
+    """The trigger-onset figure in a sentence (none without espeak word timings)."""
+    if summary is None or not summary["with_gesture"]:
+        return "\nTrigger onsets against the gold anchors: not measured (needs tts=espeak and triggers).\n"
+    return (f"\nTrigger onset within {summary['window_ms']:.0f} ms of the gold anchor's onset (espeak): "
+            f"{summary['within']}/{summary['anchors']} anchors ({100 * summary['within_share']:.1f} %); "
+            f"signed offset p5 / median / p95 {summary['p5_ms']:.0f} / {summary['p50_ms']:.0f} / "
+            f"{summary['p95_ms']:.0f} ms, {100 * summary['early_share']:.1f} % earlier and "
+            f"{100 * summary['late_share']:.1f} % later than the window, "
+            f"{summary['anchors'] - summary['with_gesture']} without a gesture.\n")

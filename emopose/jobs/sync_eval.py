@@ -12,11 +12,16 @@ every released gesture is compared with the onset espeak reports for its trigger
   stroke vs onset:    where the executed stroke lands (emopose.sync.strokes.py): the first tick
                       at which the command stream, and with a simulator the joint stream, reaches the
                       gesture's stroke-start keyframe; this is the measure the timeline mode is built for.
+With job.plans=planner the configured planner plans each text instead of the annotation: strokes are then
+measured against the planner's own trigger (stroke vs trigger) and against the gold anchor of the act
+(stroke vs gold anchor, emopose/sync/affiliate.py): a trigger that starts at its clause lands its stroke
+on the trigger, but early for the words the gesture belongs to.
 A few items per mode are drawn as timelines (words, planned and executed strokes) into the run directory.
 """
 
 from __future__ import annotations
 
+import itertools
 import logging
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,9 +30,13 @@ import numpy as np
 
 from emopose.backends.stream_tap import StreamTap
 from emopose.bench.suites import SequenceItem, load_sequence
+from emopose.contract import Plan
+from emopose.planners.base import PlanRequest
 from emopose.resources import Resources, Run
 from emopose.results import JobOutput, markdown_table
 from emopose.speech.espeak import EspeakSynthesizer
+from emopose.stages.parse import parse_output
+from emopose.sync.affiliate import gold_anchor_strokes
 from emopose.sync.plot import plot_timelines
 from emopose.sync.strokes import (
     Streams,
@@ -37,7 +46,7 @@ from emopose.sync.strokes import (
     stroke_summary,
     unmet_targets,
 )
-from emopose.sync.words import GestureSync, measure_turn, summarize
+from emopose.sync.words import GestureSync, annotated_spans, measure_turn, summarize
 from emopose.turn.pipeline import Pipeline
 from emopose.turn.runner import TurnRunner
 
@@ -53,6 +62,7 @@ class SyncEvalJob:
     target_p95_ms: float = 60.0  # words mode, scheduled vs onset
     plots: int = 4               # items drawn as timelines per mode
     stroke_targets: dict[str, float] = field(default_factory=dict)  # stroke_summary key -> bound (see yaml)
+    plans: str = "annotation"  # annotation: the gold records; planner: the configured planner's
 
     def __call__(self, run: Run) -> JobOutput:
         res = run.resources
@@ -61,21 +71,26 @@ class SyncEvalJob:
                              f"{res.synthesizer.name!r}: run it with tts=espeak")
         if res.clock.realtime:
             raise ValueError("sync_eval runs on virtual time: use backend=dry_run with run.clock=auto")
+        if self.plans not in ("annotation", "planner"):
+            raise ValueError(f"job.plans must be annotation or planner, got {self.plans!r}")
         suite_path, items = self._items()
+        plans = [self._plan(res, item) for item in items]
         run.session.open()
         tap = run.session.tap(StreamTap)
         rows: dict[str, list[GestureSync]] = {}
         strokes: dict[str, list[StrokeSync]] = {}
+        gold: dict[str, list[StrokeSync]] = {}
         for mode in self.modes:
             runner = run.runner.with_pipeline(self._pipeline(res.pipeline, mode))
-            rows[mode], strokes[mode] = [], []
-            for number, item in enumerate(items):
-                sync, stroke, turn = self._run_item(res, runner, item, tap)
+            rows[mode], strokes[mode], gold[mode] = [], [], []
+            for number, (item, plan) in enumerate(zip(items, plans)):
+                sync, stroke, gold_rows, turn = self._run_item(res, runner, item, plan, tap)
                 rows[mode] += sync
                 strokes[mode] += stroke
+                gold[mode] += gold_rows
                 if number < self.plots:
                     plot_timelines(res.run_dir / f"timeline_{mode}_{item.id}.png", item, turn, stroke)
-        results = self._results(run, suite_path, items, rows, strokes, simulated=tap.simulated)
+        results = self._results(run, suite_path, items, rows, strokes, gold, simulated=tap.simulated)
         return results, self._markdown(results)
 
     def _items(self) -> tuple[Path, list[SequenceItem]]:
@@ -103,12 +118,31 @@ class SyncEvalJob:
                          stages["sequence"].queueing(), stages["dispatch"].waiting_until("rest")],
                         inputs=("request", "plan"))
 
-    def _run_item(self, res: Resources, runner: TurnRunner, item: SequenceItem, tap: StreamTap):
+    def _plan(self, res: Resources, item: SequenceItem) -> Plan:
+        """The item's annotation, or the planner's plan of its text (its reply must be the text; one the
+        parser cut to MAX_REPLY_CHARS is restored, so every record is measured on the whole text)."""
+        if self.plans == "annotation":
+            return item.plan()
+        plan = parse_output(res.planner.plan(PlanRequest(item.text)), item.text)
+        if plan.reply != item.text and item.text.startswith(plan.reply):
+            plan = plan.model_copy(update={"reply": item.text})
+        if plan.reply != item.text:
+            raise ValueError(f"job.plans=planner needs a planner that narrates the text as given; "
+                             f"{res.planner.name} replied {plan.reply[:60]!r} to item {item.id}")
+        return plan
+
+    def _run_item(self, res: Resources, runner: TurnRunner, item: SequenceItem, plan: Plan, tap: StreamTap):
+        """Run one plan; its gestures measured against their triggers (sync, strokes) and against the
+        item's gold anchors (the same with the annotation as the plan)."""
         first = len(tap)
-        turn = runner.run_plan(item.plan(), utterance=item.text)
+        turn = runner.run_plan(plan, utterance=item.text)
         if not turn.dispatched.completed:
             log.warning("item %s did not come to rest within the dispatch timeout", item.id)
-        sync = measure_turn(item, turn, res.synthesizer.word_events(item.text))
+        planned = SequenceItem(item.id, item.text, tuple(r.cls for r in plan.records),
+                               tuple(r.trigger or "" for r in plan.records),
+                               tuple(r.variant or "" for r in plan.records))
+        events = res.synthesizer.word_events(item.text)
+        sync = measure_turn(planned, turn, events)
         loop = runner.session.loop
         times = np.asarray(tap.times[first:]) + (loop.clock.now() - loop.stream_time)  # stream -> clock time
         simulated = tap.simulated
@@ -118,17 +152,19 @@ class SyncEvalJob:
                           np.asarray(tap.states[first:]) if simulated else None)
         strokes = measure_strokes(item.id, planned_strokes(turn), [r.onset_s for r in sync], streams,
                                   turn.schedule.preroll_s)
-        return sync, strokes, turn
+        gold = gold_anchor_strokes(item.id, item.text, annotated_spans(item.text, item.anchors),
+                                   planned.anchors, strokes, events)
+        return sync, strokes, gold, turn
 
     def _results(self, run: Run, suite_path: Path, items: list[SequenceItem], rows: dict, strokes: dict,
-                 simulated: bool) -> dict:
+                 gold: dict, simulated: bool) -> dict:
         summaries = {mode: summarize(r) for mode, r in rows.items()}
-        for mode, stroke_rows in strokes.items():
-            streams = (("stroke_vs_onset", False), ("stroke_vs_onset_simulated", True))[:1 + simulated]
-            for key, sim in streams:
-                summary = stroke_summary(stroke_rows, simulated=sim)
-                unmet = unmet_targets(summary, self.stroke_targets)
-                summaries[mode][key] = {**summary, "unmet_targets": unmet}
+        for mode in strokes:
+            for key, sim in (("", False), ("_simulated", True))[:1 + simulated]:
+                for name, measured in (("stroke_vs_onset", strokes), ("stroke_vs_gold_anchor", gold)):
+                    summary = stroke_summary(measured[mode], simulated=sim)
+                    unmet = unmet_targets(summary, self.stroke_targets)
+                    summaries[mode][name + key] = {**summary, "unmet_targets": unmet}
         missing = [{"item": r.item, "k": r.k, "trigger": r.trigger}
                    for r in next(iter(rows.values()), []) if not r.found]
         for m in missing:
@@ -137,7 +173,7 @@ class SyncEvalJob:
         words_p95 = summaries.get("words", {}).get("scheduled_vs_onset", {}).get("p95_abs_ms")
         speech = run.resources.synthesizer
         return {
-            "suite": str(suite_path), "items": len(items),
+            "suite": str(suite_path), "items": len(items), "plans": self.plans,
             "tts": {"engine": speech.name, "voice": speech.voice, "rate": speech.rate},
             "control_dt_s": run.session.loop.dt, "modes": summaries,
             "target": {"words_p95_scheduled_vs_onset_ms": self.target_p95_ms, "value_ms": words_p95,
@@ -158,8 +194,9 @@ class SyncEvalJob:
                 f"{_release_table(results['modes'])}\n\n"
                 "## Where the executed strokes land\n\nExecuted stroke start: the first tick at which the "
                 "stream comes within 0.05 rad of the gesture's stroke-start keyframe; offset from the "
-                "trigger word's onset (negative: before it). Targets (within: at least; the others: "
-                f"at most): {results['stroke_targets']}.\n\n{_stroke_table(results['modes'])}\n\n"
+                "trigger word's onset, and from the onset of the gold anchor the gesture belongs to (the "
+                "same with job.plans=annotation), negative: before it. Targets (within: at least; the "
+                f"others: at most): {results['stroke_targets']}.\n\n{_stroke_table(results['modes'])}\n\n"
                 f"Target: words-mode p95 |scheduled - onset| <= "
                 f"{target['words_p95_scheduled_vs_onset_ms']:.0f} ms: "
                 f"{'met' if target['met'] else 'NOT met'} ({target['value_ms']}).\n\n"
@@ -194,14 +231,18 @@ def _release_table(modes: dict) -> str:
 
 def _stroke_table(modes: dict) -> str:
     """Where the executed strokes land, per mode and stream (command, and simulated when there is one)."""
-    header = ["mode", "stream", "planned", "arrived", "within [-200, +100] ms", "median |offset| (ms)",
-              "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)", "targets"]
+    header = ["mode", "stream", "against", "planned", "arrived", "within [-200, +100] ms",
+              "median |offset| (ms)", "p95 (ms)", "median signed (ms)", "dropped", "pre-roll p95 (ms)",
+              "targets"]
     rows = []
     for mode, s in modes.items():
-        for stream, key in (("command", "stroke_vs_onset"), ("simulated", "stroke_vs_onset_simulated")):
-            if key in s:
+        for (stream, suffix), (against, name) in itertools.product(
+                (("command", ""), ("simulated", "_simulated")),
+                (("trigger", "stroke_vs_onset"), ("gold anchor", "stroke_vs_gold_anchor"))):
+            if (key := name + suffix) in s:
                 st = s[key]
-                rows.append([mode, stream, st["n"], st["arrived"], f"{st['within_window_share']:.3f}",
+                rows.append([mode, stream, against, st["n"], st["arrived"],
+                             f"{st['within_window_share']:.3f}",
                              _ms(st, "median_abs_ms"), _ms(st, "p95_abs_ms"), _ms(st, "median_signed_ms"),
                              f"{st['dropped_share']:.3f}", f"{st['preroll_p95_ms']:.0f}",
                              "met" if not st["unmet_targets"] else "missed"])

@@ -72,6 +72,8 @@ def test_sequence_suite(run_experiment):
     assert m["exact_variant"]["mean"] == 0.0  # keyword names no variants
     assert m["anchor_recall"]["mean"] > 0     # keyword triggers are the cue words themselves
     assert set(results["segmentation"]) >= {"over_total", "under_total", "failed_total"}
+    onsets = results["anchor_onsets"]  # espeak timings: where the triggers start against the gold anchors
+    assert onsets["anchors"] == 18 and 0 <= onsets["within"] <= onsets["with_gesture"] <= 18
 
 
 def test_sequence_suite_refuses_variants_missing_from_the_library(run_experiment, tmp_path):

@@ -95,3 +95,18 @@ def test_thinking_options_build(tmp_path, compose):
     with build_run(cfg, tmp_path / "shrug") as run:
         thinking = run.runner.thinking
         assert thinking.motion == "shrug" and thinking.sequencer is run.resources.sequencer
+
+
+def test_a_planner_s_triggers_are_measured_against_the_gold_anchors_too(tmp_path, compose):
+    common = [f"job.suite={FIXTURE_SUITE}", f"tts.audio_dir={tmp_path / 'tts'}", "job.modes=[timeline]",
+              "job.plots=0", *synthetic_library(tmp_path / "library")]
+    gold = run(compose("+experiment=sync_eval", *common), tmp_path / "gold")["modes"]["timeline"]
+    assert gold["stroke_vs_gold_anchor"] == gold["stroke_vs_onset"]  # the annotation's triggers: the anchors
+    results = run(compose("+experiment=sync_eval", "planner=keyword", "job.plans=planner", *common),
+                  tmp_path / "planned")
+    planned = results["modes"]["timeline"]
+    assert results["plans"] == "planner" and planned["stroke_vs_gold_anchor"]["n"] == 16
+    assert planned["stroke_vs_gold_anchor"] != planned["stroke_vs_onset"]
+    assert "| timeline | command | gold anchor |" in (tmp_path / "planned" / "results.md").read_text()
+    with pytest.raises(ValueError, match="job.plans"):
+        run(compose("+experiment=sync_eval", "job.plans=gold", *common), tmp_path / "bad")

@@ -14,6 +14,10 @@ from typing import Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field
 
+from emopose.planners.local.direction import Frame
+
+Direction = Literal["left", "right", "up", "down", "behind", "here", "there", "this", "you", "me"]
+
 
 class TrainingConfig(BaseModel):
     """Strict types: a string or a float where an integer belongs is an error naming the field."""
@@ -68,3 +72,6 @@ class LocalSettings(BaseModel):
     history_threshold: Annotated[float, AfterValidator(_not_nan)]
     bf16_inference: bool
     trace_inference: bool
+    pointing_directions: dict[Direction, str]  # a direction word -> the pointing motion that points so
+    pointing_frame: Frame  # whose left and right (planners/local/direction.py)
+    threads: Annotated[int, Field(ge=1)] | Literal["auto"]  # torch's threads; auto: the cores free at start

@@ -10,8 +10,10 @@
    logits plus boundary logits at the chosen boundaries; neighbouring acts differ), trained as one.
 3. Per act: the motion whose library description best fits the act's words and meaning, chosen with
    its class (planners/local/variants.py; descriptions come from the live library, so a new motion is
-   selectable without retraining); intensity from cues (intensifiers and exclamations up, hedges down);
-   trigger = the words the anchor head marks around its strongest token; reply = the input text
+   selectable without retraining), and for a pointing act the direction its words name
+   (planners/local/direction.py); intensity from cues (intensifiers and exclamations up, hedges down);
+   trigger = the words the gesture belongs to (the contract's rule: its lexical affiliate, starting at the
+   word the stroke lands on): those the anchor head marks around its strongest token; reply = the input text
    (it always narrates: it has no mode to configure).
 
 The model is trained by `+experiment=train_local`, or before first use when planner.train_if_missing
@@ -40,9 +42,11 @@ from emopose.planners.local.artifact import (
     train_missing_artifact,
 )
 from emopose.planners.local.config import LocalSettings
+from emopose.planners.local.direction import pointing_motion
 from emopose.planners.local.heads import Analysis
 from emopose.planners.local.inference import LocalInference
 from emopose.planners.local.segment import Segment, segments
+from emopose.planners.local.threads import resolve_threads, torch_threads
 from emopose.planners.local.variants import ClassMove, Features, VariantChooser, Weights
 
 _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|truly|definitely|never|"
@@ -116,15 +120,23 @@ class LocalPlanner:
     @classmethod
     def from_config(cls, library: MotionLibrary, *, train_if_missing: bool, **settings) -> LocalPlanner:
         """Check the settings (LocalSettings), then, when train_if_missing, train the artifact if none is
-        cached (the first use on a fresh machine: minutes, progress bars on stderr), then load it."""
+        cached (the first use on a fresh machine: minutes, progress bars on stderr), then load it. Torch
+        gets the cores free at the start (planner.threads, planners/local/threads.py)."""
         checked = LocalSettings.model_validate(settings)
+        threads = resolve_threads(checked.threads)
         if train_if_missing:
-            train_missing_artifact(checked.train_files, checked.cache_dir, checked.training,
-                                   motion_catalogue(library))
-        return cls(library, checked)
+            with torch_threads(threads):
+                train_missing_artifact(checked.train_files, checked.cache_dir, checked.training,
+                                       motion_catalogue(library))
+        return cls(library, checked, threads)
 
-    def __init__(self, library: MotionLibrary, settings: LocalSettings) -> None:
-        """Load the cached artifact for the settings; none is an error naming the job that trains it."""
+    def __init__(self, library: MotionLibrary, settings: LocalSettings, threads: int | None = None) -> None:
+        """Load the cached artifact for the settings; none is an error naming the job that trains it.
+        threads: torch's pool for inference (None: resolved from planner.threads now)."""
+        import torch
+
+        self.threads = resolve_threads(settings.threads) if threads is None else threads
+        torch.set_num_threads(self.threads)
         self.library, self.settings = library, settings
         self.variant_weights = Weights(settings.variant_word_weight, settings.variant_shared_weight,
                                        settings.variant_pretrained_share)
@@ -146,8 +158,9 @@ class LocalPlanner:
     def retrain(self) -> None:
         """Train again (replacing the cached artifact) and use the new model (train_local's job.retrain)."""
         settings = self.settings
-        self._load(train_artifact(settings.train_files, settings.cache_dir, settings.training,
-                                  self._catalogue()))
+        with torch_threads(self.threads):
+            self._load(train_artifact(settings.train_files, settings.cache_dir, settings.training,
+                                      self._catalogue()))
 
     def plan(self, request: PlanRequest) -> PlannerOutput:
         with timed() as clock:
@@ -206,9 +219,16 @@ class LocalPlanner:
     def _record(self, act: _Act, analysis: Analysis, utterance: str) -> dict:
         text = utterance[act.start:act.end]
         start, end = trigger_span(utterance, analysis, (act.start, act.end))
-        return {"class": act.cls, "variant": act.variant,
-                "intensity": intensity_from_cues(text), "trigger": utterance[start:end],
-                "confidence": round(float(act.proba[CLASSES.index(act.cls)]), 3)}
+        trigger, variant = utterance[start:end], act.variant
+        directional = self.settings.pointing_directions.values()
+        # a direction the words name decides among the directional motions (planners/local/direction.py);
+        # a pointing motion outside them (one added by file) that fits the words best keeps its pick
+        if act.cls == "pointing" and variant in directional:
+            pointing = frozenset(n for n, (cls, _) in self._catalogue().items() if cls == "pointing")
+            variant = pointing_motion((trigger, text), self.settings.pointing_directions, pointing,
+                                      self.settings.pointing_frame) or variant
+        return {"class": act.cls, "variant": variant, "intensity": intensity_from_cues(text),
+                "trigger": trigger, "confidence": round(float(act.proba[CLASSES.index(act.cls)]), 3)}
 
     def _catalogue(self) -> dict[str, tuple[str, str]]:
         return motion_catalogue(self.library)

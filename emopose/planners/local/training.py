@@ -5,7 +5,9 @@ annotated act's pooled semantic and lexical vectors); each epoch then runs only 
 layers and the heads over the cache, which is what makes first-use training a few minutes on two
 cores. Matrix products run in bfloat16 (autocast) where the CPU supports it natively; weights and
 optimiser state stay float32; the learning rates warm up and decay linearly when lr_schedule says so.
-Every pass shows a progress bar with ETA on stderr. The losses are planners/local/losses.py's.
+Every pass shows a progress bar on stderr; its `left` figure is the ETA of the whole training (Remaining:
+this pass and the ones after it, from the measured time per batch), not only of the pass. The losses are
+planners/local/losses.py's.
 
 The variant projections read only frozen states, so they are trained after the epochs, on the cached
 act vectors, in seconds (planners/local/variant_training.py).
@@ -16,6 +18,7 @@ from __future__ import annotations
 import logging
 import random
 import sys
+import time
 
 from emopose.planners.local.data import Example
 from emopose.planners.local.heads import pooled, token_range
@@ -75,8 +78,10 @@ def train(model: ActModel, examples: list[Example], catalogue: dict[str, tuple[s
     model.learn_words(sorted({e.text for e in examples}))
     model.annotated_motions = sorted({v for e in examples for v in e.variants if v})
     bf16 = torch.ops.mkldnn._is_mkldnn_bf16_supported()
-    cache, annotated = frozen_passes(model, length_batches(model, examples), catalogue, bf16, progress)
-    fit_top(model, top, cache, len(examples), rng, bf16, progress)
+    batches = length_batches(model, examples)
+    remaining = Remaining(len(batches), cfg.epochs * len(batches))
+    cache, annotated = frozen_passes(model, batches, catalogue, bf16, progress, remaining)
+    fit_top(model, top, cache, len(examples), rng, bf16, progress, remaining)
     fit_variants(model.variant_projections, annotated, describe(model, catalogue), cfg, progress)
 
 
@@ -99,8 +104,39 @@ def length_batches(model: ActModel, examples: list[Example]) -> list[list[Exampl
     return [by_length[k:k + size] for k in range(0, len(by_length), size)]
 
 
+class Remaining:
+    """The whole training's time left: frozen batches at their measured pace, epoch batches at theirs
+    (before the first is measured: EPOCH_COST times a frozen batch's; 2.8 was measured on a loaded 2-core
+    machine with one thread: 0.71 s a frozen batch, 1.96 s an epoch batch)."""
+
+    EPOCH_COST = 2.5
+
+    def __init__(self, frozen: int, epoch: int) -> None:
+        self.left = {"frozen": frozen, "epoch": epoch}
+        self.spent = {"frozen": 0.0, "epoch": 0.0}
+        self.done = {"frozen": 0, "epoch": 0}
+        self._since = time.perf_counter()
+
+    def step(self, kind: str) -> str:
+        """Count one batch of `kind` as done; the time left, as m:ss."""
+        now = time.perf_counter()
+        self.spent[kind] += now - self._since
+        self._since = now
+        self.done[kind] += 1
+        self.left[kind] -= 1
+        pace = {k: self.spent[k] / self.done[k] for k in self.done if self.done[k]}
+        frozen = pace.get("frozen", 0.0)
+        epoch = pace.get("epoch", self.EPOCH_COST * frozen)
+        seconds = round(self.left["frozen"] * frozen + self.left["epoch"] * epoch)
+        return f"{seconds // 60}:{seconds % 60:02d}"
+
+    def restart(self) -> None:
+        """Do not count time between passes (the variant pass, the optimiser's setup) as a batch's."""
+        self._since = time.perf_counter()
+
+
 def frozen_passes(model: ActModel, batches: list[list[Example]], catalogue: dict[str, tuple[str, str]],
-                  bf16: bool, progress: bool) -> tuple[list[tuple], list[AnnotatedAct]]:
+                  bf16: bool, progress: bool, remaining: Remaining) -> tuple[list[tuple], list[AnnotatedAct]]:
     """One pass of the frozen layers over every batch: (batch, tokens, float16 states) per batch, and
     the annotated acts' vectors for the variant projections."""
     import torch
@@ -108,18 +144,21 @@ def frozen_passes(model: ActModel, batches: list[list[Example]], catalogue: dict
 
     cache, annotated = [], []
     with torch.no_grad(), torch.autocast("cpu", dtype=torch.bfloat16, enabled=bf16):
-        for batch in tqdm(batches, desc="local planner: frozen layers", unit="batch", file=sys.stderr,
-                          disable=not progress):
+        bar = tqdm(batches, desc="local planner: frozen layers", unit="batch", file=sys.stderr,
+                   disable=not progress)
+        remaining.restart()
+        for batch in bar:
             tokens = model.tokens([e.text for e in batch], [e.history for e in batch])
             lower = model.lower(tokens.inputs)
             if catalogue and any(e.variants for e in batch):  # the pretrained top and the words: variants
                 annotated += annotated_acts(model, batch, tokens, lower)
             cache.append((batch, tokens, lower.half()))
+            bar.set_postfix(all_left=remaining.step("frozen"), refresh=False)
     return cache, annotated
 
 
 def fit_top(model: ActModel, top, cache: list[tuple], examples: int, rng: random.Random, bf16: bool,
-            progress: bool) -> None:
+            progress: bool, remaining: Remaining) -> None:
     """The epochs over the cached frozen states: the top layers and the heads (examples: how many)."""
     import torch
     from tqdm import tqdm
@@ -142,6 +181,7 @@ def fit_top(model: ActModel, top, cache: list[tuple], examples: int, rng: random
             total = 0.0
             bar = tqdm(cache, desc=f"local planner: epoch {epoch + 1}/{cfg.epochs}", unit="batch",
                        file=sys.stderr, disable=not progress)
+            remaining.restart()
             for batch, tokens, lower in bar:
                 with torch.autocast("cpu", dtype=torch.bfloat16, enabled=bf16):
                     loss = batch_loss(model, batch, tokens, lower.float())
@@ -150,7 +190,7 @@ def fit_top(model: ActModel, top, cache: list[tuple], examples: int, rng: random
                 optimizer.step()
                 scheduler.step()
                 total += loss.item() * len(batch)
-                bar.set_postfix(loss=f"{loss.item():.3f}")
+                bar.set_postfix(loss=f"{loss.item():.3f}", all_left=remaining.step("epoch"), refresh=False)
             log.info("local planner epoch %d/%d: loss %.4f", epoch + 1, cfg.epochs, total / examples)
     finally:
         model.body.set_attn_implementation(attention)
