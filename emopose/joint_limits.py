@@ -24,6 +24,11 @@ class JointLimits:
     lower: np.ndarray
     upper: np.ndarray
     max_velocity: np.ndarray
+    # The tracking reserve (the limits file's `tracking_reserve`): commands are planned at most
+    # speed_fraction of max_velocity and at least limit_margin inside lower/upper, because the arm under its
+    # law overshoots what it is sent; the measured joints then stay inside the bounds themselves.
+    speed_fraction: float = 1.0
+    limit_margin: float = 0.0
 
     @classmethod
     def from_file(cls, path: str | Path) -> JointLimits:
@@ -33,6 +38,9 @@ class JointLimits:
             names = tuple(raw["joints"])
             lower, upper = (np.asarray(raw[k], dtype=float) for k in ("lower", "upper"))
             velocity = np.broadcast_to(np.asarray(raw.get("max_velocity", 6.0), dtype=float), (NUM_JOINTS,))
+            reserve = raw.get("tracking_reserve") or {}
+            fraction = float(reserve.get("speed_fraction", 1.0))
+            margin = float(reserve.get("limit_margin", 0.0))
         except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
             raise LibraryError(
                 f"{path}: cannot read joint limits ({exc!r}); need joints, lower, upper"
@@ -42,7 +50,16 @@ class JointLimits:
         if np.any(lower >= upper):
             bad = [names[j] for j in np.flatnonzero(lower >= upper)]
             raise LibraryError(f"{path}: lower must be below upper for {bad}")
-        return cls(names, lower, upper, velocity.copy())
+        if not (0.0 < fraction <= 1.0 and 0.0 <= margin < float(np.min(upper - lower)) / 2):
+            raise LibraryError(f"{path}: tracking_reserve needs 0 < speed_fraction <= 1 and "
+                               f"0 <= limit_margin < half the narrowest range; got {fraction}, {margin}")
+        return cls(names, lower, upper, velocity.copy(), fraction, margin)
+
+    def planning(self) -> JointLimits:
+        """The bounds commands are planned in: the hard limits and speed bounds less the tracking reserve."""
+        m = self.limit_margin
+        velocity = self.max_velocity * self.speed_fraction
+        return JointLimits(self.names, self.lower + m, self.upper - m, velocity)
 
     def project(self, q: np.ndarray, margin: float = 0.0) -> np.ndarray:
         """Pi_j: clip into [q- + margin, q+ - margin] joint-wise; works on (14,) or (T, 14)."""

@@ -8,19 +8,21 @@ give either stream time t (the control loop's seconds since its stream began; `s
 that is on the clock, and a restarted stream moves it on, never back) or nothing (`write_now`: stamped
 on arrival, its time fields read from the loop's clock).
 
-Nothing is lost but the last moment: the messages go into zstd chunks that a background thread closes,
-writes and fsyncs every FLUSH_S, so a killed process (kill -9, a power cut) loses at most the chunk in
-progress; `python -m emopose.recover FILE` rewrites such a torn file into a complete one.
+Nothing is lost but the last moment: writers only stamp, encode and queue a message; a background thread
+puts the queue into zstd chunks and closes, writes and fsyncs one every FLUSH_S, so a killed process
+(kill -9, a power cut) loses at most the chunk in progress; `python -m emopose.recover FILE` rewrites such
+a torn file into a complete one.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
 import threading
 import time
-from collections import defaultdict
+from collections import defaultdict, deque
 from pathlib import Path
 from typing import Any
 
@@ -57,8 +59,10 @@ class Recorder:
         self._stream = self.path.open("wb")
         self._writer = Writer(self._stream)
         self._writer.start(profile="", library="emopose")
-        self._channels: dict[str, tuple[int, list[tuple[str, ...]]]] = {}
-        self._lock = threading.Lock()
+        self._channels: dict[str, int] = {}
+        self._pending: deque[tuple[str, int, bytes]] = deque()  # stamped, encoded, not yet in the file
+        self._order = threading.Lock()  # stamps and stream zero; held for microseconds, by any writer
+        self._io = threading.Lock()  # the MCAP writer: the flusher thread and close() only
         self._closed = threading.Event()
         self.clock = clock or MonotonicClock()
         self.origin = self.clock.now()  # the recording's zero on its clock
@@ -66,15 +70,26 @@ class Recorder:
         self.start_ns = time.time_ns()
         self._writer.add_metadata(METADATA, {"start_ns": str(self.start_ns)})
         if describe_robot:
-            from emopose.robot.urdf import robot_urdf
-
-            self.write_now("/robot_description", {"data": robot_urdf()})
+            self._describe_robot()
         self._flusher = threading.Thread(target=self._flush_every, name="mcap-flush", daemon=True)
         self._flusher.start()
 
+    def _describe_robot(self) -> None:
+        """The URDF first (building it takes a while: a stop signal landing here still leaves a whole,
+        readable file behind, not a torn header)."""
+        try:
+            from emopose.robot.urdf import robot_urdf
+
+            self.write_now("/robot_description", {"data": robot_urdf()})
+        except BaseException:
+            self._closed.set()
+            self._writer.finish()
+            self._stream.close()
+            raise
+
     def start_stream(self, zero: float) -> None:
         """Stream time 0 is clock time `zero` from now on (a stream began, or began again)."""
-        with self._lock:
+        with self._order:
             if zero < self._stream_zero:
                 raise ValueError(
                     f"recorder: a stream cannot restart in the past ({zero} < {self._stream_zero})"
@@ -89,54 +104,66 @@ class Recorder:
         """Stream time t on the recorder's clock."""
         return self._stream_zero + t
 
-    def _channel(self, topic: str) -> tuple[int, list[tuple[str, ...]]]:
+    def write(self, topic: str, t: float, payload: dict[str, Any]) -> None:
+        """Record payload at stream time t; it is recorded with `t` = that time on the session clock."""
+        with self._order:
+            at = self._stream_zero - self.origin + t
+        self._queue(topic, at, {**payload, "t": at})
+
+    def write_now(self, topic: str, payload: dict[str, Any]) -> None:
+        """Record payload at the clock's current time (stamped on arrival); its session-time fields are
+        given on the clock."""
+        with self._order:
+            at = self.clock.now() - self.origin
+        times = _session_time_paths(topic)
+        self._queue(topic, at, _shifted(payload, times, -self.origin) if times else payload)
+
+    def _queue(self, topic: str, offset_s: float, payload: dict) -> None:
+        """Encode and queue a message; the flusher thread writes it. A writer (the 50 Hz control loop
+        among them) never waits for compression or the disk."""
+        if self._closed.is_set():
+            return
+        stamp = self.start_ns + int(round(offset_s * 1e9))
+        self._pending.append((topic, stamp, json.dumps(payload, separators=(",", ":")).encode()))
+
+    def flush(self) -> None:
+        """Write the queued messages, close the chunk in progress and put it on disk."""
+        with self._io:
+            self._write_pending()
+            self._writer.flush()
+            os.fsync(self._stream.fileno())
+
+    def _write_pending(self) -> None:
+        while self._pending:
+            topic, stamp, data = self._pending.popleft()
+            channel = self._channel(topic)
+            self._writer.add_message(channel_id=channel, log_time=stamp, publish_time=stamp, data=data)
+
+    def _channel(self, topic: str) -> int:
         if topic not in self._channels:
-            schema = SCHEMAS.get(topic, GENERIC_SCHEMA)
             schema_id = self._writer.register_schema(
                 name=FOXGLOVE_NAMES.get(topic, topic.strip("/").replace("/", ".")),
                 encoding="jsonschema",
-                data=json.dumps(schema).encode(),
+                data=json.dumps(_schema(topic)).encode(),
             )
-            channel = self._writer.register_channel(topic=topic, message_encoding="json", schema_id=schema_id)
-            self._channels[topic] = channel, session_time_paths(schema)
+            self._channels[topic] = self._writer.register_channel(
+                topic=topic, message_encoding="json", schema_id=schema_id
+            )
         return self._channels[topic]
 
-    def write(self, topic: str, t: float, payload: dict[str, Any]) -> None:
-        """Record payload at stream time t; it is recorded with `t` = that time on the session clock."""
-        with self._lock:
-            at = self._stream_zero - self.origin + t
-            self._add(topic, at, {**payload, "t": at})
-
-    def write_now(self, topic: str, payload: dict[str, Any]) -> None:
-        """Record payload at the clock's current time (stamped under the lock: in arrival order); its
-        session-time fields are given on the clock."""
-        with self._lock:
-            self._add(topic, self.clock.now() - self.origin, payload, from_clock=True)
-
-    def _add(self, topic: str, offset_s: float, payload: dict, from_clock: bool = False) -> None:
-        if self._closed.is_set():
-            return
-        channel, times = self._channel(topic)
-        if from_clock and times:
-            payload = _shifted(payload, times, -self.origin)
-        stamp = self.start_ns + int(round(offset_s * 1e9))
-        data = json.dumps(payload, separators=(",", ":")).encode()
-        self._writer.add_message(channel_id=channel, log_time=stamp, publish_time=stamp, data=data)
-
     def _flush_every(self) -> None:
-        """Close the chunk in progress and put it on disk, every FLUSH_S until close()."""
+        """flush() every FLUSH_S until close()."""
         while not self._closed.wait(FLUSH_S):
-            with self._lock:
-                self._writer.flush()
-            os.fsync(self._stream.fileno())  # close() waits for this thread before closing the file
+            self.flush()
 
     def close(self) -> None:
-        with self._lock:
+        with self._order:
             if self._closed.is_set():
                 return
             self._closed.set()  # no more messages; the flusher stops
         self._flusher.join()
-        with self._lock:
+        with self._io:
+            self._write_pending()
             self._writer.finish()
             self._stream.close()
 
@@ -145,6 +172,15 @@ class Recorder:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _schema(topic: str) -> dict:
+    return SCHEMAS.get(topic, GENERIC_SCHEMA)
+
+
+@functools.cache
+def _session_time_paths(topic: str) -> list[tuple[str, ...]]:
+    return session_time_paths(_schema(topic))
 
 
 def _shifted(payload: dict, paths: list[tuple[str, ...]], by: float) -> dict:

@@ -77,12 +77,12 @@ def test_mujoco_applies_the_law_the_robot_is_sent():
 
 def arrival_delay_ticks(law: ArmLaw) -> int:
     """Ticks between the command and the simulated arm coming within the stroke tolerance of a raised
-    pose, after a preparation from rest as fast as the speed bound allows (1.5 rad in 0.32 s: a first
-    gesture squeezed into the speech pre-roll)."""
+    pose, after a preparation from rest about as fast as the planning speed bound allows (1.5 rad in 0.46 s:
+    a first gesture squeezed into the speech pre-roll)."""
     backend = MujocoBackend(law=law, initial_pose=[0.0] * len(RAISED))  # the arms hanging straight down
     backend.connect(None)
     rest = backend.measured().copy()
-    ramp = smoothstep(np.linspace(0.0, 1.0, 17))[:, None]
+    ramp = smoothstep(np.linspace(0.0, 1.0, 24))[:, None]
     commands = np.vstack([rest + ramp * (RAISED - rest), np.repeat(RAISED[None], 25, axis=0)])
     states = []
     for n, q in enumerate(commands):
@@ -97,7 +97,7 @@ def test_the_default_law_neither_sags_nor_trails_a_fast_preparation(compose):
     assert default.gravity_compensation and default.velocity_feedforward and default.tracking_lag_s == 0.0
     assert sag_after_holding(default) < 0.005
     # the arm arrives with the command; without the velocity reference the kd term brakes it and the
-    # under-damped kp-60 joint settles within the tolerance only several ticks later
+    # joint settles within the tolerance only several ticks later
     assert arrival_delay_ticks(default) <= 1 and arrival_delay_ticks(ROBOT_GRAVITY) >= 4
 
 

@@ -46,11 +46,11 @@ def test_a_trigger_on_the_first_word_delays_the_speech_by_a_bounded_preroll(g1):
 
 def test_overlapping_gestures_coarticulate_from_the_previous_stroke_end(g1):
     first, second = gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")
-    (a, b), _ = planner(g1).plan([first, second], [1.0, 2.6])
+    (a, b), _ = planner(g1).plan([first, second], [1.0, 2.8])
     assert a.cut and len(a.times) == a.stroke[1] + 1  # cut after its stroke end: no retraction
     assert b.fit == "coarticulated" and b.blend_in and b.times[0] >= a.times[-1] - 1e-9
-    assert b.arrival_s == pytest.approx(2.6 - 0.05)
-    assert arrival(g1, b, a.keyframes[-1]) == pytest.approx(2.55, abs=0.021)
+    assert b.arrival_s == pytest.approx(2.8 - 0.05)
+    assert arrival(g1, b, a.keyframes[-1]) == pytest.approx(2.75, abs=0.021)
 
 
 def test_a_closer_trigger_shortens_the_previous_stroke(g1):
@@ -123,16 +123,16 @@ def test_an_unsafe_direct_blend_is_kept_through_a_safe_via_pose(g1):
     # a safety check that passes only paths through the rest pose: the direct blends and the halfway via fail
     through_rest = lambda samples: (  # noqa: E731
         None if np.min(np.max(np.abs(samples - rest), axis=1)) < 1e-3 else "arms collide")
-    (a, b), _ = planner(g1, safety=through_rest).plan([first, second], [1.0, 2.2])
+    (a, b), _ = planner(g1, safety=through_rest).plan([first, second], [1.0, 2.6])
     assert b.fit == "via_rest" and b.blend_in and a.cut
     assert np.allclose(b.keyframes[1], rest)  # the via pose, before the preparation
     assert b.stroke == tuple(i + 1 for i in second.resolved.entry.stroke_span)
-    assert arrival(g1, b, a.keyframes[-1]) == pytest.approx(2.2 - 0.05, abs=0.021)
+    assert arrival(g1, b, a.keyframes[-1]) == pytest.approx(2.6 - 0.05, abs=0.021)
     builder = TrajectoryBuilder(g1.limits)
     poses = [a.keyframes[-1], *b.keyframes[1:]]
     for i in range(1, len(b.times)):
         assert b.times[i] - b.times[i - 1] >= builder.segment_minimum(poses[i - 1], poses[i], i == 1) - 1e-9
-    (_, dropped), _ = planner(g1, safety=lambda samples: "arms collide").plan([first, second], [1.0, 2.2])
+    (_, dropped), _ = planner(g1, safety=lambda samples: "arms collide").plan([first, second], [1.0, 2.6])
     assert "unsafe (arms collide) and no safe via pose fits" in dropped
 
 

@@ -23,7 +23,7 @@ def _written(tmp_path):
         recorder.write_now("/note", {"k": k})
         clock.sleep_until(clock.now() + 0.01)
         if k % 50 == 49:
-            recorder._writer.flush()  # what the flusher thread does every FLUSH_S
+            recorder.flush()  # what the flusher thread does every FLUSH_S
     return recorder
 
 

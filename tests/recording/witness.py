@@ -19,16 +19,16 @@ WITNESS = "EMOPOSE_WITNESS"
 
 
 def witness_every_message(fd: int) -> None:
-    record = Recorder._add
+    record = Recorder._queue
 
-    def witnessed(self, topic, offset_s, payload, from_clock=False):
+    def witnessed(self, topic, offset_s, payload):
         was_closed = self._closed.is_set()  # a closed recorder drops the message
-        record(self, topic, offset_s, payload, from_clock)
+        record(self, topic, offset_s, payload)
         if not was_closed:
-            stamp = self.start_ns + int(round(offset_s * 1e9))  # the log time Recorder._add gave it
+            stamp = self.start_ns + int(round(offset_s * 1e9))  # the log time Recorder._queue gave it
             os.write(fd, f"{time.time_ns()} {stamp} {topic}\n".encode())
 
-    Recorder._add = witnessed
+    Recorder._queue = witnessed
 
 
 def read_witness(path) -> list[tuple[int, int, str]]:
