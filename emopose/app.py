@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 
 def run(cfg: DictConfig, run_dir: str | Path) -> dict:
     run_dir = Path(run_dir)
-    job_name = str(OmegaConf.select(cfg, "job._target_") or "job").rpartition(".")[2]
+    job_name = name_of_job(cfg)
     # Before anything else: a reused run directory must never show a previous run's results as this run's.
     write_results(run_dir, {"job": job_name, "completed": False, "in_progress": True},
                   f"# {job_name} in progress\n\nNo results yet: the run is still going, or was killed.")
@@ -46,7 +46,7 @@ def run(cfg: DictConfig, run_dir: str | Path) -> dict:
     except BaseException as exc:
         interrupt = interrupt_behind(exc)
         if not written:
-            _write_unfinished(run_dir, job_name, exc, interrupt)
+            write_unfinished(run_dir, job_name, exc, interrupt)
         if interrupt is None or interrupt is exc:
             raise
         raise interrupt from exc  # a stop signal a library wrapped (ctypes.ArgumentError) ends as itself
@@ -70,9 +70,15 @@ def _outcome(job: Callable[[Run], JobOutput], built: Run) -> tuple[dict, str, Ba
         return failure.results, failure.markdown, failure.error
 
 
-def _write_unfinished(run_dir: Path, job: str, error: BaseException,
-                      interrupt: KeyboardInterrupt | None) -> None:
-    """results.json / results.md for a job that never returned: interrupted, or failed with `error`."""
+def name_of_job(cfg: DictConfig) -> str:
+    """The job's class name, as results.json names it."""
+    return str(OmegaConf.select(cfg, "job._target_") or "job").rpartition(".")[2]
+
+
+def write_unfinished(run_dir: Path, job: str, error: BaseException,
+                     interrupt: KeyboardInterrupt | None) -> None:
+    """results.json / results.md for a job that never returned: interrupted, or failed with `error`
+    (also emopose.__main__'s, for a stop signal that came before run() could write them)."""
     if interrupt is None:
         problem = " ".join(str(error).split()) or type(error).__name__
         write_results(run_dir, {"job": job, "completed": False, "error": problem},

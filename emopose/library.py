@@ -29,6 +29,7 @@ log = logging.getLogger(__name__)
 # The largest motion file read: the longest sequence the schema allows (14 keyframes of 14 values), written
 # one full-precision value a line, is under 5 KB; 64 KiB leaves room for comments.
 MAX_FILE_BYTES = 64 * 1024
+MAX_PROBLEMS = 3  # a file's first problems named in its one-line error; the rest counted
 
 
 @dataclass(frozen=True)
@@ -154,13 +155,13 @@ class MotionLibrary:
         """Validate one motion (a mapping as in a library file) against the schema and the joint limits."""
         if not isinstance(raw, dict):
             raise LibraryError(f"{source}: expected a mapping with name, class, description, keyframes")
-        try:
-            entry = LibraryEntry.model_validate(raw)
+        try:  # strict: `duration: "2"` or `stroke: [1.0, 2]` is refused, not coerced
+            entry = LibraryEntry.model_validate(_lists_as_tuples(raw), strict=True)
         except ValidationError as exc:
-            name = raw.get("name", "?")
-            problems = "; ".join(f"{'.'.join(map(str, e['loc'])) or 'entry'}: {e['msg']}"
-                                 for e in exc.errors())
-            raise LibraryError(f"{source}: motion '{name}': {problems}") from exc
+            problems = [_problem(error) for error in exc.errors()]
+            more = f"; and {len(problems) - MAX_PROBLEMS} more" if len(problems) > MAX_PROBLEMS else ""
+            raise LibraryError(f"{source}: motion '{raw.get('name', '?')}': "
+                               f"{'; '.join(problems[:MAX_PROBLEMS])}{more}") from exc
         bad = self.limits.violation_details(entry.q, self.limit_margin)
         if bad:
             raise LibraryError(
@@ -220,3 +221,21 @@ class MotionLibrary:
         os.replace(tmp, target)
         self.reload()
         return entry
+
+
+def _lists_as_tuples(value: object) -> object:
+    """A parsed file's lists as tuples: in strict mode the contract's tuple fields take tuples only."""
+    if isinstance(value, list):
+        return tuple(_lists_as_tuples(v) for v in value)
+    if isinstance(value, dict):
+        return {key: _lists_as_tuples(v) for key, v in value.items()}
+    return value
+
+
+def _problem(error: dict) -> str:
+    """One validation error as `field: rule`, with the value given when its type was wrong."""
+    where = ".".join(map(str, error["loc"])) or "entry"
+    given = error.get("input")
+    if error["type"].endswith("_type"):  # the wrong type: say which value, briefly
+        return f"{where}: {error['msg']}, got {type(given).__name__} {repr(given)[:40]}"
+    return f"{where}: {error['msg']}"

@@ -13,6 +13,9 @@ arrive as itself: a library may swallow it (uvicorn.run returns normally after i
 or wrap it (raised while ctypes converts a call's arguments, as in mujoco's EGL probing, it becomes a
 ctypes.ArgumentError). app.run turns either back into the interrupt, so every job ends with the same
 results and the same exit status: 143 after SIGTERM, 130 after SIGINT.
+
+`python -m emopose` enters stop_signals_interrupt() before it imports anything else (emopose/__main__.py),
+so this module imports only the standard library: a signal during those seconds of imports is handled too.
 """
 
 from __future__ import annotations

@@ -11,11 +11,12 @@ import time
 from dataclasses import dataclass
 
 from emopose.bench.metrics import paired_context_accuracy
-from emopose.bench.suites import load_context
+from emopose.bench.suites import ContextItem, load_context
 from emopose.bench.tables import comparison_markdown
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     check_passes,
+    load_suite,
     plan_suite,
     resolve_passes,
     run_summary,
@@ -35,13 +36,12 @@ class ContextAblationJob:
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
 
     def __post_init__(self) -> None:
-        check_passes(self.passes)  # a config error when the job is built, before anything starts
+        """The suite is read when the job is built: a bad value is a config error before anything starts."""
+        check_passes(self.passes)
+        self.items: list[ContextItem] = load_suite(load_context, self.path)  # not a field, so no setting
 
     def __call__(self, run: Run) -> JobOutput:
-        res = run.resources
-        items = load_context(self.path)
-        if not items:
-            raise ValueError(f"{self.path} has no items (bench.path)")
+        res, items = run.resources, self.items
         planner, passes = res.planner, resolve_passes(self.passes, res.planner)
         with_history = [PlanRequest(utterance=i.text, history=i.history) for i in items]
         without_history = [PlanRequest(utterance=i.text) for i in items]

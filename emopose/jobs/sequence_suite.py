@@ -16,12 +16,13 @@ from dataclasses import dataclass
 
 from emopose.bench.metrics import aggregate_passes
 from emopose.bench.sequence_metrics import SequencePrediction, suite_scores
-from emopose.bench.suites import load_sequence
+from emopose.bench.suites import SequenceItem, load_sequence
 from emopose.bench.tables import comparison_markdown
 from emopose.jobs.suite_planning import (
     MAX_FALLBACK_SHARE,
     PlannedItem,
     check_passes,
+    load_suite,
     plan_suite,
     resolve_passes,
     run_summary,
@@ -54,15 +55,15 @@ class SequenceSuiteJob:
     max_fallback_share: float = MAX_FALLBACK_SHARE  # above it the run is marked and exits 2
 
     def __post_init__(self) -> None:
-        check_passes(self.passes)  # a config error when the job is built, before anything starts
+        """The suite is read when the job is built: a bad value is a config error before anything starts."""
+        check_passes(self.passes)
+        self.items: list[SequenceItem] = load_suite(load_sequence, self.path)  # not a field, so no setting
 
     def __call__(self, run: Run) -> JobOutput:
-        res = run.resources
-        entries = res.library.snapshot.entries
-        variant_classes = {name: e.cls for name, e in entries.items()} if self.check_variants else None
-        items = load_sequence(self.path, variant_classes)
-        if not items:
-            raise ValueError(f"{self.path} has no items (bench.path)")
+        res, items = run.resources, self.items
+        if self.check_variants:  # the library exists only now: read again, a SuiteError names the line
+            entries = res.library.snapshot.entries
+            items = load_sequence(self.path, {name: e.cls for name, e in entries.items()})
         planner, passes = res.planner, resolve_passes(self.passes, res.planner)
         requests = [PlanRequest(utterance=i.text) for i in items]
         per_pass, predictions, planned_all = [], [], []

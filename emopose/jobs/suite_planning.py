@@ -67,6 +67,18 @@ def check_passes(passes: int | None) -> None:
                          f"1 otherwise)")
 
 
+def load_suite(loader: Callable[..., list], path: str, *args: object) -> list:
+    """A suite job's items, read when the job is built: a missing or unreadable file, or one without
+    items, is a ValueError naming bench.path (a config error, exit 2, before anything starts)."""
+    try:
+        items = loader(path, *args)
+    except OSError as exc:  # missing, a folder, unreadable
+        raise ValueError(f"bench.path={path}: {exc.strerror or exc}") from exc
+    if not items:
+        raise ValueError(f"bench.path={path}: no items")
+    return items
+
+
 def resolve_passes(passes: int | None, planner: Planner) -> int:
     """`passes` as configured, or by default 5 for a sampled planner (planner.sampled) and 1 otherwise."""
     check_passes(passes)

@@ -77,3 +77,38 @@ def test_a_motion_without_a_stroke_gets_the_largest_excursion_with_a_warning(tmp
     assert library.get("no_stroke").stroke is None and library.get("no_stroke").stroke_span == (2, 2)
     assert "no_stroke.yaml: no `stroke" in caplog.text
     assert library.get("neutral_rest").stroke_span == (0, 0)  # a pose is its own stroke
+
+
+def write_fields(folder, name: str, **fields: str):
+    """A motion file from raw YAML values, so that a test can write any type."""
+    lines = {"name": name, "class": "pointing", "description": "typed test motion",
+             "keyframes": str([REST, [v - 0.1 for v in REST], REST]), **fields}
+    path = folder / f"{name}.yaml"
+    path.write_text("".join(f"{key}: {value}\n" for key, value in lines.items()))
+    return path
+
+
+@pytest.mark.parametrize("fields,named", [
+    ({"duration": '"2"'}, "duration: Input should be a valid number, got str '2'"),
+    ({"duration": "true"}, "duration: Input should be a valid number, got bool True"),
+    ({"stroke": "[1.0, 1]"}, "stroke.0: Input should be a valid integer, got float 1.0"),
+    ({"stroke": '["1", "1"]'}, "stroke.0: Input should be a valid integer, got str '1'"),
+    ({"description": "2024-01-01"}, "description: Input should be a valid string, got date"),
+    ({"keyframes": str([REST, ["0.1"] * 14, REST])}, "keyframes.1.0: Input should be a valid number, got"),
+])
+def test_a_value_of_the_wrong_type_is_refused_not_coerced(tmp_path, fields, named):
+    folder = make_library_dir(tmp_path / "lib")
+    path = write_fields(folder, "typed_one", **fields)
+    with pytest.raises(LibraryError) as refused:
+        load_library(folder)
+    message = str(refused.value)
+    assert message.startswith(f"{path}: motion 'typed_one': ") and named in message, message
+    assert "\n" not in message and len(message) < 600  # one line, the first problems only
+
+
+def test_whole_numbers_are_numbers(tmp_path):
+    folder = make_library_dir(tmp_path / "lib")
+    write_fields(folder, "whole_numbers", duration="2", stroke="[1, 1]",
+                 keyframes=str([[0] * 14, [0.1] * 14, [0] * 14]))
+    entry = load_library(folder).get("whole_numbers")
+    assert entry.duration == 2.0 and entry.stroke == (1, 1) and entry.keyframes[0] == (0.0,) * 14

@@ -42,7 +42,12 @@ class Handover:
         self._out, self._neutral = output, neutral
 
     def ramp_up(self) -> None:
-        """Weight 0 -> 1 while holding the measured pose; lost state on the way refuses the start."""
+        """Weight 0 -> 1 while holding the measured pose; lost state on the way refuses the start.
+
+        The feed-forwards rise with the weight, as a release lowers them (release.py, tau = G(q*) w/w0):
+        tau = G(hold) w, so the first command carries almost none and no tick changes tau by more than
+        max|G| sin(pi / 2n) over the ramp's n ticks (0.2 N m with the 1 s default and |G| <= 6.3 N m).
+        """
         s, out = self._settings, self._out
         hold = out.last.q.copy()
         grid = DeadlineGrid(self._clock, CONTROL_DT)
@@ -54,7 +59,8 @@ class Handover:
                     f"({out.link.where()})"
                 )
             with self._life.lock:
-                out.publish(hold, float(w), "ramp_up")
+                dq, tau = out.link.feedforward(hold)  # dq* 0 while holding; G under the measured torso
+                out.publish(hold, float(w), "ramp_up", feed=(w * dq, w * tau))
             grid.sent()
 
     def release(self, reason: str | None, blend: bool = True) -> None:

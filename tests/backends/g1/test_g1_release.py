@@ -122,3 +122,26 @@ def test_gravity_feedforward_reads_the_measured_torso(fake_robot, domain_id):
     held = next(c for c in robot.wait_for("arm", 30) if c["weight"] == 1.0)
     assert np.allclose(held["tau"], tilted, atol=1e-4)  # float32 on the wire
     assert np.abs(tilted - upright).max() > 1.0  # what the upright assumption missed
+
+
+def test_the_ramp_up_feedforward_rises_with_the_weight(fake_robot, domain_id, tmp_path):
+    """tau = G(hold) w from the first ramp tick on, as the release lowers it: no effort step when the
+    weight begins to rise (before: the first command at weight 0.006 carried the whole G, 5 N m here)."""
+    pose = [-1.2, 0.3, 0.0, 0.0, 0.0, 0.0, 0.0, -1.2, -0.3, 0.0, 0.0, 0.0, 0.0, 0.0]  # arms raised forward
+    fake_robot(f"--arm-pose={','.join(map(str, pose))}")  # one argument, though it starts with "-"
+    clock = FakeClock()
+    recorder = Recorder(tmp_path / "run.mcap", clock=clock)
+    backend = G1Backend(domain_id=domain_id, clock=clock, **FAST)
+    backend.connect(recorder)
+    backend.close()
+    recorder.close()
+    _, sent = lowcmds(tmp_path / "run.mcap")
+    ramp = [p for p in sent if p["phase"] == "ramp_up"]
+    weights = np.array([p["weight"] for p in ramp])
+    tau, dq = np.array([p["tau"] for p in ramp]), np.array([p["dq"] for p in ramp])
+    assert len(ramp) == round(FAST["weight_ramp_up_s"] / DT) and weights[-1] == 1.0
+    held = tau[-1]  # G(hold) under the measured torso, at full weight
+    assert np.abs(held).max() > 4.0  # a gravity torque worth ramping
+    assert np.allclose(tau, weights[:, None] * held, atol=1e-9) and not dq.any()
+    effort = np.vstack([np.zeros(14), KD * dq + tau])  # from no command at all to the full hold
+    assert np.abs(np.diff(effort, axis=0)).max() <= MAX_EFFORT_STEP_NM
