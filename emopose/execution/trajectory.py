@@ -4,11 +4,14 @@ G: the keyframe path q_last -> q~_1 -> ... -> q~_{K-1} (the first segment starts
 published pose in place of q~_0, so the initial transition is embedded and the duration stays d) is
 cut into M = 5 smoothstep increments per segment, w_{k,r} = q_{k-1} + s(r/M)(q_k - q_{k-1}) with
 s(u) = 3u^2 - 2u^3, then linearly resampled at 50 Hz and projected into the hard limits.
-A pose (one keyframe) is a single segment from q_last to the pose.
+A pose (one keyframe) is a single segment from q_last to the pose. A library entry may state when each
+keyframe is reached (`times`); the segments then follow those times, with the same easing.
 
-Beyond the paper: if a sample step would exceed the joint speed bound (for example an intensity-5
-excursion, or a start far from the first keyframe), the whole trajectory is slowed down uniformly
-until it does not; `stretch` reports the factor. Blends get the same treatment.
+Beyond the paper: commands are planned inside the limits file's tracking reserve (JointLimits.planning: a
+share of max_velocity, a margin inside the hard limits), so the measured arm, which overshoots its commands,
+stays inside the bounds themselves. If a sample step would exceed that speed bound (for example an
+intensity-5 excursion, or a start far from the first keyframe), the whole trajectory is slowed down
+uniformly until it does not; `stretch` reports the factor. Blends get the same treatment.
 
 Timed construction (the timeline): each keyframe has its own time, so segments differ in length; a
 segment too short for the speed bound is lengthened and everything after it moves later (`late_s`).
@@ -23,7 +26,7 @@ stands on its way to the next keyframe, so the joint-space path stays the one th
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -67,17 +70,18 @@ class Trajectory:
 
 
 class TrajectoryBuilder:
-    """Builds G(entry keyframes, intensity-modulated, q_last) and blends, within limits and speed bounds."""
+    """Builds G(entry keyframes, intensity-modulated, q_last) and blends, within limits and speed bounds
+    less the limits file's tracking reserve."""
 
     def __init__(self, limits: JointLimits, dt: float = CONTROL_DT, increments: int = SMOOTHSTEP_INCREMENTS):
-        self.limits = limits
+        self.limits = limits.planning()  # the hard limits and speed bounds less the tracking reserve
         self.dt = dt
         self.increments = increments
         self._s = smoothstep(np.arange(1, increments + 1) / increments)[None, :, None]
         # Largest waypoint step as a fraction of its segment (the middle increment of the smoothstep).
         self._steepest = float(np.max(np.diff(smoothstep(np.arange(increments + 1) / increments))))
         self._weights_cache: dict[tuple[int, float], np.ndarray] = {}
-        self._inv_velocity = 1.0 / limits.max_velocity
+        self._inv_velocity = 1.0 / self.limits.max_velocity
 
     def waypoints(self, keyframes: np.ndarray, q_last: np.ndarray) -> np.ndarray:
         """Eq. smoothstep waypoints, (segments * M + 1, 14), starting at q_last."""
@@ -95,7 +99,13 @@ class TrajectoryBuilder:
         frac = (x - i0)[:, None]
         return waypoints[i0] + frac * (waypoints[i0 + 1] - waypoints[i0])
 
-    def build(self, keyframes: np.ndarray, duration: float, q_last: np.ndarray) -> Trajectory:
+    def build(self, keyframes: np.ndarray, duration: float, q_last: np.ndarray,
+              times: tuple[float, ...] | None = None) -> Trajectory:
+        """G from q_last through keyframes[1:] (a pose: to its keyframe) over `duration`, the keyframes evenly
+        spaced; or, given `times` (a library entry's own, times[0] = 0, times[-1] the duration), each
+        keyframe reached at its time."""
+        if times is not None:
+            return self._build_authored(keyframes, times, q_last)
         # Same result as resample(waypoints(...)) (to ~1e-14), built in few numpy calls: every sample is a
         # fixed linear mix of the anchors that depends only on (segments, duration), so that matrix is
         # cached and a build is one product. The speed check needs only the anchor steps, since the
@@ -119,6 +129,29 @@ class TrajectoryBuilder:
         total = duration * stretch
         ticks = tuple(self.tick(total * i / len(rest)) for i in range(len(rest) + 1))
         return Trajectory(samples, self.dt, stretch, ticks, anchors=anchors)
+
+    def _build_authored(self, keyframes: np.ndarray, times: tuple[float, ...],
+                        q_last: np.ndarray) -> Trajectory:
+        """Keyframe k reached at times[k]; slowed down uniformly, as build() is, so that no segment breaks the
+        speed bound (an intensity-5 excursion, a start away from keyframe 0): the rhythm is kept."""
+        anchors = np.vstack([q_last, np.asarray(keyframes, dtype=float)[1:]])
+        gaps = np.diff(times)
+        ratio = max(self.segment_minimum(a, b) / gap for a, b, gap in zip(anchors[:-1], anchors[1:], gaps))
+        stretch = ratio * 1.001 if ratio > 1.0 else 1.0
+        return replace(self.build_timed(anchors, np.asarray(times[1:]) * stretch, q_last), stretch=stretch)
+
+    def timing_faults(self, keyframes: np.ndarray, times: tuple[float, ...]) -> list[str]:
+        """Authored keyframe times the speed bound forbids, keyframes as written: one line per segment naming
+        the keyframe, its time, the fastest joint and the shortest time the bound allows."""
+        q, out = np.asarray(keyframes, dtype=float), []
+        for k in range(1, len(q)):
+            gap, needed = times[k] - times[k - 1], self.segment_minimum(q[k - 1], q[k])
+            if needed > gap + 1e-9:
+                j = int(np.argmax(np.abs(q[k] - q[k - 1]) * self._inv_velocity))
+                out.append(f"K{k} at {times[k]:.2f} s comes {gap:.2f} s after K{k - 1}; "
+                           f"{self.limits.names[j]} needs {needed:.2f} s for it at its planning speed "
+                           f"({self.limits.max_velocity[j]:.2f} rad/s)")
+        return out
 
     def tick(self, t: float) -> int:
         """The first sample index at or after time t."""

@@ -67,6 +67,7 @@ class DraftReport:
     # joints outside the library's limits (+ margin): the library refuses these
     keyframe_violations: list[str]
     trajectory_violations: list[str]
+    timing_faults: list[str]  # authored keyframe times the joint speed bound forbids: saving refuses them
     levels: list[LevelCheck]  # from rest
     starts: list[StartCheck]  # from the other poses the arm can start in (rest excluded)
     check_s: float  # what checking every start pose at every level took
@@ -82,6 +83,7 @@ class DraftReport:
     def problems(self) -> list[str]:
         """What blocks saving."""
         out = [self._outside_limits] if self.keyframe_violations else []
+        out += [f"keyframe times too fast for the joint speed bound: {fault}" for fault in self.timing_faults]
         out += [f"self-collision at intensity {c.intensity} (the sequencer would reject it): {c.reason}"
                 for c in self.levels if not c.ok]
         return out
@@ -97,8 +99,8 @@ class DraftReport:
     def refusal_at(self, intensity: int) -> str | None:
         """Why the draft cannot be performed at this intensity (None: it can)."""
         level = next(c for c in self.levels if c.intensity == intensity)
-        if self.keyframe_violations:
-            return self._outside_limits
+        if self.keyframe_violations or self.timing_faults:
+            return self.problems[0]
         return None if level.ok else f"self-collision at intensity {intensity}: {level.reason}"
 
     @property
@@ -119,11 +121,12 @@ class PoseStudio:
 
     def draft(self, keyframes: list[list[float]], motion_type: str = "sequence",
               duration: float | None = None, cls: str = "neutral",
-              stroke: tuple[int, int] | None = None) -> LibraryEntry:
-        """Schema-check the keyframes and stroke (not the limits: those are reported, so the author can
-        fix them)."""
+              stroke: tuple[int, int] | None = None, times: list[float] | None = None) -> LibraryEntry:
+        """Schema-check the keyframes, stroke and keyframe times (not the limits nor the speed bound: those
+        are reported, so the author can fix them)."""
         raw = {"name": DRAFT_NAME, "class": cls, "description": "Pose Studio draft",
-               "motion_type": motion_type, "duration": duration, "keyframes": keyframes, "stroke": stroke}
+               "motion_type": motion_type, "duration": duration, "keyframes": keyframes, "stroke": stroke,
+               "times": times}
         try:
             return LibraryEntry.model_validate(raw)
         except ValidationError as exc:
@@ -137,19 +140,22 @@ class PoseStudio:
         levels, chosen = [], None
         for level in LEVELS:
             q = self.modulate.keyframes(entry.q, level)
-            trajectory = self.builder.build(q, entry.default_duration, start)
+            trajectory = self.builder.build(q, entry.default_duration, start, entry.times)
             levels.append(self._check(level, trajectory))
             if level == intensity:
                 chosen = (q, trajectory)
         starts = [self._check_from(entry, label, pose) for label, pose in self.start_poses(entry)[1:]]
         keyframes, trajectory = chosen
         limits = self.library.limits
-        rule = entry.model_copy(update={"duration": None}).default_duration  # Eq. duration, shown beside
+        # Eq. duration, shown beside
+        rule = entry.model_copy(update={"duration": None, "times": None}).default_duration
         return DraftReport(
             intensity=intensity, duration=entry.default_duration, default_duration=rule,
             explicit_duration=entry.duration is not None, keyframes=keyframes, trajectory=trajectory,
             keyframe_violations=limits.violations(entry.q, self.library.limit_margin),
-            trajectory_violations=limits.violations(trajectory.samples), levels=levels, starts=starts,
+            trajectory_violations=limits.violations(trajectory.samples),
+            timing_faults=self.builder.timing_faults(entry.q, entry.times) if entry.times else [],
+            levels=levels, starts=starts,
             check_s=time.perf_counter() - started)
 
     def start_poses(self, entry: LibraryEntry) -> list[tuple[str, np.ndarray]]:
@@ -170,7 +176,7 @@ class PoseStudio:
         failed, first = [], None
         for level in LEVELS:
             trajectory = self.builder.build(self.modulate.keyframes(entry.q, level), entry.default_duration,
-                                            start)
+                                            start, entry.times)
             reason = self._refusal(trajectory)
             if reason is not None:
                 failed.append(level)

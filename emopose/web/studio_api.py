@@ -59,7 +59,7 @@ def library_entry(request: Request, name: str = Path(pattern=NAME_PATTERN)) -> d
 def _draft(request: Request, body: DraftRequest, cls: str = "neutral") -> tuple[LibraryEntry, DraftReport]:
     studio = session_of(request).studio
     try:
-        entry = studio.draft(body.keyframes, body.motion_type, body.duration, cls, body.stroke)
+        entry = studio.draft(body.keyframes, body.motion_type, body.duration, cls, body.stroke, body.times)
     except DraftError as exc:
         raise HTTPException(422, f"draft: {exc}") from exc
     return entry, studio.report(entry, body.intensity)
@@ -74,14 +74,13 @@ def check(body: DraftRequest, request: Request) -> dict:
     """The 50 Hz trajectory the robot would run at this intensity, and every check, before saving."""
     entry, report = _draft(request, body)
     trajectory = report.trajectory
-    k = len(body.keyframes)
-    span = trajectory.duration
     return {
         "intensity": report.intensity, "duration": report.duration,
         "default_duration": report.default_duration,
         "explicit_duration": report.explicit_duration, "dt": trajectory.dt, "stretch": trajectory.stretch,
         "samples": _round(trajectory.samples), "keyframes": _round(report.keyframes),
-        "keyframe_times": [span * i / max(k - 1, 1) for i in range(k)] if k > 1 else [span],
+        "keyframe_times": _keyframe_times(entry, trajectory.duration, trajectory.stretch),
+        "times_declared": entry.times is not None, "timing_faults": report.timing_faults,
         "stroke": list(entry.stroke_span), "stroke_declared": entry.stroke is not None,
         "keyframe_violations": report.keyframe_violations,
         "trajectory_violations": report.trajectory_violations,
@@ -90,6 +89,14 @@ def check(body: DraftRequest, request: Request) -> dict:
         "warnings": report.warnings, "checked": report.checked, "check_ms": report.check_s * 1e3,
         "stick": stick_frames(trajectory.samples, STICK_EVERY), "stick_dt": trajectory.dt * STICK_EVERY,
     }
+
+
+def _keyframe_times(entry: LibraryEntry, span: float, stretch: float) -> list[float]:
+    """When the run reaches each keyframe: its own times (slowed with the run), else evenly spaced."""
+    if entry.times is not None:
+        return [t * stretch for t in entry.times]
+    k = len(entry.keyframes)
+    return [span * i / (k - 1) for i in range(k)] if k > 1 else [span]
 
 
 @router.post("/studio/preview")

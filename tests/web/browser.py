@@ -108,3 +108,14 @@ def watched_page(browser, base: str, width: int = 1400, height: int = 900):
         context.close()
     assert not foreign, f"the page fetched from outside the server: {foreign}"
     assert not errors, f"JavaScript errors: {errors}"
+
+
+@contextlib.contextmanager
+def studio_page(browser, base: str):
+    """A watched page on Pose Studio, ready to edit (its first draft checked)."""
+    from playwright.sync_api import expect
+
+    with watched_page(browser, base) as page:
+        page.goto(base + "/studio")
+        expect(page.locator("#verdict")).to_have_text("ready to save", timeout=15_000)
+        yield page

@@ -12,7 +12,7 @@ import re
 import pytest
 
 from tests.conftest import write_motion
-from tests.web.browser import SHOTS, served, watched_page
+from tests.web.browser import SHOTS, served, studio_page
 from tests.web.test_cue_outcomes import REACH_IN, REST
 
 pytestmark = pytest.mark.slow
@@ -32,9 +32,7 @@ def server(tmp_path_factory):
 
 @pytest.fixture
 def studio(browser, server):
-    with watched_page(browser, server["base"]) as page:
-        page.goto(server["base"] + "/studio")
-        expect(page.locator("#verdict")).to_have_text("ready to save", timeout=15_000)
+    with studio_page(browser, server["base"]) as page:
         yield page
 
 

@@ -2,19 +2,19 @@
 // preview it in MuJoCo, perform the draft on the robot, and save it into the live library.
 import { api, el, fillBadges } from "./common.js";
 import { DraftHistory, wireUndo } from "./studio_history.js";
+import { keyframeTimes, renderTiming, round, wireKeyframes, wireTimeDrag } from "./studio_keyframes.js";
 import { wireLibraryActions } from "./studio_library.js";
 import { preview } from "./studio_preview.js";
 
 const $ = (id) => document.getElementById(id);
-const MIRROR = [1, -1, -1, 1, -1, 1, -1]; // q_right = MIRROR * q_left (emopose/robot/kinematics.py)
 const NAME_RE = /^[a-z][a-z0-9_]{1,63}$/;
-const S = { library: null, keyframes: [], stroke: null, selected: 0, report: null, frames: null, t: 0, playing: false };
+const S = { library: null, keyframes: [], stroke: null, times: null, clipboard: null, selected: 0, report: null,
+  frames: null, t: 0, playing: false };
 let checkTimer = null, checkSeq = 0;
 const edits = new DraftHistory();
 const DRAFT = "__draft__"; // the Motion menu's entry for the draft on screen
 const { renderChecks, drawAll, play, showPreviewFrames, renderPreview } = preview(S, draft, () => updateSaveButton());
 
-const round = (v) => Math.round(v * 1000) / 1000;
 const neutral = () => [...S.library.neutral_pose];
 
 async function loadLibrary(keep) {
@@ -32,14 +32,14 @@ async function loadLibrary(keep) {
 function snapshot() {
   return { name: $("name").value, class: $("class").value, description: $("description").value,
     motion_type: $("motion-type").value, explicit: $("explicit").checked, duration: $("duration").value,
-    keyframes: S.keyframes, stroke: S.stroke };
+    keyframes: S.keyframes, stroke: S.stroke, times: S.times };
 }
 
 function restore(state) {
   $("name").value = state.name; $("class").value = state.class; $("description").value = state.description;
   $("motion-type").value = state.motion_type; $("explicit").checked = state.explicit;
   $("duration").value = state.duration;
-  S.keyframes = state.keyframes; S.stroke = state.stroke;
+  S.keyframes = state.keyframes; S.stroke = state.stroke; S.times = state.times;
   S.selected = Math.min(S.selected, S.keyframes.length - 1);
   refresh();
 }
@@ -68,8 +68,9 @@ function setMotion(entry, opened = null) {
   $("name").value = entry.name; $("class").value = entry.class; $("description").value = entry.description;
   $("motion-type").value = entry.motion_type;
   $("explicit").checked = entry.duration !== null && entry.duration !== undefined;
-  $("duration").value = entry.duration ?? 2.0;
+  $("duration").value = entry.duration ?? entry.times?.at(-1) ?? 2.0;
   S.keyframes = entry.keyframes.map((k) => [...k]);
+  S.times = entry.times ? [...entry.times] : null;
   S.stroke = entry.stroke ? [...entry.stroke] : null;
   S.selected = Math.min(1, S.keyframes.length - 1);
   S.frames = null; showPreviewFrames();
@@ -86,7 +87,8 @@ function newMotion() {
 
 function draft() {
   return { keyframes: S.keyframes, motion_type: $("motion-type").value, intensity: Number($("intensity").value),
-           duration: $("explicit").checked ? Number($("duration").value) : null, stroke: S.stroke };
+           duration: $("explicit").checked && !S.times ? Number($("duration").value) : null, stroke: S.stroke,
+           times: S.times };
 }
 
 // Sync points: the stroke is a span of interior keyframes; an edit that breaks it falls back to auto.
@@ -98,8 +100,7 @@ function fixStroke() {
 
 function refresh() {
   fixStroke();
-  renderKeyframes(); renderSliders(); renderNameHint();
-  $("duration").disabled = !$("explicit").checked;
+  renderKeyframes(); renderSliders(); renderNameHint(); renderTiming(S);
   clearTimeout(checkTimer);
   checkTimer = setTimeout(check, 150); // debounce slider drags
 }
@@ -108,7 +109,8 @@ function renderKeyframes() {
   const list = $("keyframes");
   const arm = (kf, side) => `${side} ${kf.slice(side === "L" ? 0 : 7, side === "L" ? 7 : 14).map((v) => v.toFixed(2)).join(" ")}`;
   list.replaceChildren(...S.keyframes.map((kf, k) => el("li", { class: k === S.selected ? "selected" : "", onclick: () => { S.selected = k; refresh(); } },
-    el("span", { class: "k", text: `K${k}` }),
+    el("span", { class: "k", style: "width:auto;min-width:40px" }, el("div", { text: `K${k}` }),
+      el("div", { class: "small muted", text: `${keyframeTimes(S)[k].toFixed(2)} s` })),
     el("span", { class: "sum" }, el("span", { text: arm(kf, "L") }), el("span", { text: arm(kf, "R") })),
     el("span", { class: "stroke-mark", text: strokeMark(k) }))));
   const pose = $("motion-type").value === "pose";
@@ -194,14 +196,10 @@ async function check() {
 
 function edit(fn) { fn(); refresh(); committed(); }
 const kf = () => S.keyframes[S.selected];
-$("kf-add").onclick = () => edit(() => { S.keyframes.splice(S.selected + 1, 0, [...kf()]); S.selected += 1; });
-$("kf-remove").onclick = () => edit(() => { S.keyframes.splice(S.selected, 1); S.selected = Math.max(0, S.selected - 1); });
-const swap = (d) => edit(() => { const k = S.selected; [S.keyframes[k], S.keyframes[k + d]] = [S.keyframes[k + d], S.keyframes[k]]; S.selected = k + d; });
-$("kf-up").onclick = () => swap(-1); $("kf-down").onclick = () => swap(1);
-$("kf-neutral").onclick = () => edit(() => { S.keyframes[S.selected] = neutral(); });
-$("mirror-lr").onclick = () => edit(() => { const q = kf(); for (let j = 0; j < 7; j++) q[7 + j] = round(MIRROR[j] * q[j]); });
-$("mirror-rl").onclick = () => edit(() => { const q = kf(); for (let j = 0; j < 7; j++) q[j] = round(MIRROR[j] * q[7 + j]); });
+wireKeyframes({ S, edit, neutral });
+wireTimeDrag({ S, refresh, committed, moved: () => { refreshLight(); renderTiming(S); drawAll(); } });
 $("motion-type").onchange = () => edit(() => {
+  S.times = null; // a pose has no keyframe times; a new sequence starts evenly spaced
   if ($("motion-type").value === "pose") { S.keyframes = [kf()]; S.selected = 0; }
   else if (S.keyframes.length < 3) { S.keyframes = [neutral(), kf(), neutral()]; S.selected = 1; }
 });
@@ -230,7 +228,7 @@ $("scrub").oninput = () => { S.playing = false; const r = S.report; if (r) { S.t
 wireLibraryActions({
   draft,
   motion: () => ({ name: $("name").value, class: $("class").value, description: $("description").value,
-    motion_type: $("motion-type").value, duration: draft().duration, stroke: S.stroke, keyframes: S.keyframes }),
+    motion_type: $("motion-type").value, duration: draft().duration, stroke: S.stroke, times: S.times, keyframes: S.keyframes }),
   opened: () => S.opened,
   after: async (name, saved) => {
     S.opened = name;

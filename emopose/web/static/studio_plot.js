@@ -3,6 +3,18 @@
 // when in view.
 
 const SHORT = ["shoulder pitch", "shoulder roll", "shoulder yaw", "elbow", "wrist roll", "wrist pitch", "wrist yaw"];
+const PAD_LEFT = 8, GAP = 10; // px: left margin, and between the left- and right-arm columns
+
+const cellWidth = (width) => (width - PAD_LEFT - GAP) / 2;
+const span = (report) => Math.max((report.samples.length - 1) * report.dt, 1e-6);
+
+// The time (s on the plotted run) under a pointer `x` px from the canvas' left edge, in either column;
+// `slop`: how many seconds a few px are, to find a keyframe line under the pointer.
+export function timeAtX(canvas, report, x) {
+  const w = cellWidth(canvas.clientWidth), col = x < PAD_LEFT + w + GAP / 2 ? 0 : 1;
+  const perPx = span(report) / w;
+  return { t: (x - PAD_LEFT - col * (w + GAP)) * perPx, slop: 6 * perPx };
+}
 
 export function drawCurves(canvas, report, limits, selected, cursor = null) {
   const ratio = window.devicePixelRatio || 1;
@@ -12,18 +24,17 @@ export function drawCurves(canvas, report, limits, selected, cursor = null) {
   g.setTransform(ratio, 0, 0, ratio, 0, 0);
   g.clearRect(0, 0, width, height);
   if (!report) return;
-  const samples = report.samples, n = samples.length, span = Math.max((n - 1) * report.dt, 1e-6);
-  const cols = 2, rows = 7, padL = 8, gap = 10, titleH = 14;
-  const cellW = (width - padL - gap) / cols, cellH = height / rows;
+  const samples = report.samples, n = samples.length, seconds = span(report);
+  const rows = 7, titleH = 14, cellW = cellWidth(width), cellH = height / rows;
   g.font = "11px system-ui, sans-serif";
   for (let j = 0; j < 14; j++) {
     const col = j < 7 ? 0 : 1, row = j % 7;
-    const x0 = padL + col * (cellW + gap), y0 = row * cellH + titleH, w = cellW, h = cellH - titleH - 6;
+    const x0 = PAD_LEFT + col * (cellW + GAP), y0 = row * cellH + titleH, w = cellW, h = cellH - titleH - 6;
     const values = samples.map((s) => s[j]);
     let lo = Math.min(...values), hi = Math.max(...values);
     const mid = (lo + hi) / 2, half = Math.max((hi - lo) / 2 + 0.05, 0.15);
     lo = mid - half; hi = mid + half;
-    const X = (t) => x0 + (t / span) * w, Y = (v) => y0 + h - ((v - lo) / (hi - lo)) * h;
+    const X = (t) => x0 + (t / seconds) * w, Y = (v) => y0 + h - ((v - lo) / (hi - lo)) * h;
     g.fillStyle = "#f7f9fc"; g.fillRect(x0, y0, w, h);
     g.fillStyle = "#6b7385";
     g.fillText(`${col ? "R" : "L"} ${SHORT[row]}  [${values[0].toFixed(2)} → ${values[n - 1].toFixed(2)}]`, x0, y0 - 3);

@@ -9,14 +9,17 @@ export function preview(S, draft, updateSaveButton) {
   function renderChecks(r) {
     const K = S.keyframes.length;
     $("duration-rule").textContent = `default rule d = clip(0.3·(K−1), 1, 5) = clip(0.3·${K - 1}, 1, 5) = ${r.default_duration.toFixed(2)} s`
-      + (r.explicit_duration ? ` · overridden: ${r.duration.toFixed(2)} s` : " · used");
+      + (r.times_declared ? ` · not used: the last keyframe's time is the duration, ${r.duration.toFixed(2)} s`
+        : r.explicit_duration ? ` · overridden: ${r.duration.toFixed(2)} s` : " · used");
     $("traj-meta").textContent = `${r.samples.length} samples · ${((r.samples.length - 1) * r.dt).toFixed(2)} s · intensity ${r.intensity}`;
     $("check-limits").replaceChildren(r.keyframe_violations.length
       ? el("span", { class: "pill bad", text: `outside: ${r.keyframe_violations.join(", ")}` }) : el("span", { class: "pill ok", text: "within limits" }));
     $("check-levels").replaceChildren(...r.levels.map((c) => el("span", { class: `pill ${c.ok ? "ok" : "bad"}`,
       title: c.reason || "", text: `i${c.intensity} ${c.ok ? "✓" : "✗"} ${(c.min_clearance_m * 100).toFixed(1)} cm` })));
-    $("check-speed").replaceChildren(r.stretch > 1.001
-      ? el("span", { class: "pill warn", text: `slowed ×${r.stretch.toFixed(2)} to respect joint speed limits` }) : el("span", { class: "pill ok", text: "within speed limits" }));
+    const [speed, said] = r.timing_faults.length ? ["bad", "keyframe times too fast for the speed bound (below)"]
+      : r.stretch > 1.001 ? ["warn", `slowed ×${r.stretch.toFixed(2)} to respect joint speed limits`]
+      : ["ok", "within speed limits"];
+    $("check-speed").replaceChildren(el("span", { class: `pill ${speed}`, text: said }));
     $("check-notes").replaceChildren(...r.problems.map((p) => el("li", { class: "bad", style: "color:var(--bad)", text: p })),
       ...r.warnings.map((w) => el("li", { class: "warn", text: `warning: ${w}` })),
       el("li", { class: "muted small", text: `checked: ${r.checked} (${r.check_ms.toFixed(0)} ms)` }));
