@@ -11,9 +11,18 @@ from enum import StrEnum
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, create_model, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationInfo,
+    create_model,
+    field_validator,
+    model_validator,
+)
 
-from emopose import CLASSES, NUM_JOINTS
+from emopose import CLASSES, CONTROL_DT, NUM_JOINTS
 
 GestureClass = Literal[
     "pointing", "emphasizing", "rejecting", "agreeing", "doubting", "welcoming", "comforting", "neutral"
@@ -27,6 +36,7 @@ PlanSource = Literal["model", "retried", "scripted", "plain_text", "empty", "unk
 USABLE_SOURCES = frozenset({"model", "retried", "scripted"})
 
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
+MAX_DURATION_S = 20.0  # the longest motion a library entry may state (its duration or last keyframe time)
 # The longest text of a record (the parser cuts a trigger or variant to it at a word), and the piece a
 # tour line is planned in (whole sentences under it); a reply keeps more (stages/parse.py MAX_SPOKEN_CHARS).
 MAX_REPLY_CHARS = 200
@@ -49,6 +59,7 @@ class EventKind(StrEnum):
     REJECTED = "rejected"  # refused by the safety check
     DROPPED = "dropped"  # the timeline could not fit it
     STATE = "state"  # the sequencer's state changed (detail: the new state)
+    POSTURE = "posture"  # the arms head for another posture between gestures (detail: its name; posture.py)
 
 
 def trigger_position(reply: str, trigger: str | None) -> int | None:
@@ -129,11 +140,14 @@ class LibraryEntry(BaseModel):
     cls: GestureClass = Field(alias="class")
     description: str = Field(min_length=3, max_length=200)
     motion_type: MotionType = "sequence"
-    duration: float | None = Field(default=None, gt=0.0, le=20.0)
+    duration: float | None = Field(default=None, gt=0.0, le=MAX_DURATION_S)
     keyframes: tuple[tuple[float, ...], ...]
     # Sync points (BML's stroke_start, stroke_end) as keyframe indices: where the expressive part of the
     # motion begins and ends. The timeline puts the stroke start on the trigger word.
     stroke: tuple[int, int] | None = None
+    # When each keyframe is reached, s from the motion's start (times[0] = 0; the last is the duration).
+    # Without it the keyframes are evenly spaced over the duration.
+    times: tuple[float, ...] | None = None
     _q: np.ndarray = PrivateAttr()
 
     @field_validator("keyframes")
@@ -145,6 +159,28 @@ class LibraryEntry(BaseModel):
             if not all(np.isfinite(frame)):
                 raise ValueError(f"keyframe {k} contains a non-finite value")
         return frames
+
+    @field_validator("times")
+    @classmethod
+    def _timed(cls, times: tuple[float, ...] | None, info: ValidationInfo) -> tuple[float, ...] | None:
+        if times is None:
+            return None
+        if info.data.get("motion_type") == "pose":
+            raise ValueError("a pose has no keyframe times; give its duration instead")
+        if info.data.get("duration") is not None:
+            raise ValueError("give times or duration, not both (the last keyframe's time is the duration)")
+        count = len(info.data.get("keyframes", times))
+        if len(times) != count:
+            raise ValueError(f"{len(times)} times for {count} keyframes; give one time per keyframe")
+        if times[0] != 0.0:
+            raise ValueError(f"times[0] is {times[0]}; keyframe 0 is where the motion starts, at 0 s")
+        for k in range(1, len(times)):
+            if not times[k] - times[k - 1] >= CONTROL_DT - 1e-9:  # also refuses NaN
+                raise ValueError(f"K{k} at {times[k]} s must come at least {CONTROL_DT} s (one control tick) "
+                                 f"after K{k - 1} at {times[k - 1]} s")
+        if times[-1] > MAX_DURATION_S:
+            raise ValueError(f"the last keyframe at {times[-1]} s: a motion lasts at most {MAX_DURATION_S} s")
+        return times
 
     @model_validator(mode="after")
     def _count(self) -> LibraryEntry:
@@ -184,9 +220,12 @@ class LibraryEntry(BaseModel):
 
     @property
     def default_duration(self) -> float:
-        """Paper Eq. duration: d(Q) = clip(0.3 (K - 1), 1, 5) s, unless the entry sets one explicitly."""
+        """Paper Eq. duration: d(Q) = clip(0.3 (K - 1), 1, 5) s, unless the entry sets one explicitly (its
+        duration, or its last keyframe time)."""
         if self.duration is not None:
             return self.duration
+        if self.times is not None:
+            return self.times[-1]
         return float(np.clip(0.3 * (len(self.keyframes) - 1), 1.0, 5.0))
 
 

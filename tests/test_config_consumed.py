@@ -100,6 +100,9 @@ CONSUMERS = {
     "player": lambda cfg, run: built_from(cfg.player, run.resources.player, "sink", "latency_s"),
     "thinking": lambda cfg, run: built_from(cfg.thinking, run.runner.thinking, "motion", "repeats"),
     "arm_law": arm_law_applied_by_the_simulator,
+    "posture": lambda cfg, run: built_from(cfg.posture, run.resources.sequencer.posture.settings,
+                                           "idle_motion", "transition_s", "idle_amplitude", "breath_period_s",
+                                           "fade_in_s"),
 }
 
 

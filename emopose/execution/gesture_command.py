@@ -43,10 +43,12 @@ class State(StrEnum):
 
     IDLE/HOLDING --released command--> EXECUTING (trajectory built from the latest published pose)
     EXECUTING --done, successor released--> BLENDING (cubic, <= blend_s) --> EXECUTING
-    EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not neutral--> BLENDING to neutral
+    EXECUTING --done, nothing released--> HOLDING --hold_s, endpoint not home--> BLENDING home
                                                     (recover_s) --> IDLE
     any --interrupt--> pending cleared, BLENDING (interrupt_blend_s) toward the new target --> EXECUTING
-    EXECUTING --stall, stroke too late--> BLENDING to neutral (recover_s)
+    EXECUTING --stall, stroke too late--> BLENDING home (recover_s)
+    IDLE/HOLDING (nothing queued) or BLENDING home --posture changed--> BLENDING to it (transition_s)
+    "home" is the current posture (rest, listening, thinking: posture.py), neutral without one.
     """
 
     IDLE = "idle"

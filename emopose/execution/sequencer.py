@@ -7,46 +7,45 @@ release from the pose published then, preempting (CUT) a motion still running, l
 speed bound forbids. After a stall a running gesture catches up (TrajectoryBuilder.catch_up) or is
 STOPPED when its stroke would be over `stall_stop_late_s` late. STROKE: the arm within STROKE_TOLERANCE of
 the stroke-start keyframe, as commanded or, where the backend measures its joints (`observe`, the
-StrokeWatch), as measured, the command's arrival then being STROKE_COMMANDED.
+StrokeWatch), as measured, the command's arrival then being STROKE_COMMANDED. Between gestures the arms
+go to the current posture, where they may breathe (posture.py: the posture layer).
 """
 
 from __future__ import annotations
 
-import threading
 import time
-from collections import deque
 from collections.abc import Callable
-from dataclasses import replace
 
 import numpy as np
 
 from emopose.contract import EventKind
 from emopose.execution.bounded_log import BoundedLog
+from emopose.execution.command_queue import CommandQueue
 from emopose.execution.gesture_command import Event, GestureCommand, State
+from emopose.execution.posture import PostureLayer, PostureSettings
 from emopose.execution.stroke_watch import StrokeWatch
 from emopose.execution.trajectory import Trajectory, TrajectoryBuilder
 
 SafetyCheck = Callable[[np.ndarray], "str | None"]
 
 
-class Sequencer:
+class Sequencer(CommandQueue):
     def __init__(self, builder: TrajectoryBuilder, neutral: np.ndarray, safety: SafetyCheck | None = None,
                  blend_s: float = 0.3, hold_s: float = 2.0, recover_s: float = 1.0,
                  interrupt_blend_s: float = 0.3, neutral_tolerance: float = 0.02,
                  preempt_after_s: float | None = None, stall_stop_late_s: float = 0.5,
-                 on_event: Callable[[Event], None] | None = None, keep_events: int = 10_000) -> None:
+                 on_event: Callable[[Event], None] | None = None, keep_events: int = 10_000,
+                 posture: PostureSettings | None = None) -> None:
+        super().__init__(on_event, keep_events)
         self.builder = builder
         self.neutral = np.asarray(neutral, dtype=float)
+        self.posture = PostureLayer(posture, self.neutral, builder.limits, builder.dt)  # None: rest, still
         self.safety = safety
         self.blend_s, self.hold_s, self.recover_s = blend_s, hold_s, recover_s
         self.interrupt_blend_s, self.neutral_tolerance = interrupt_blend_s, neutral_tolerance
         self.preempt_after_s, self.stall_stop_late_s = preempt_after_s, stall_stop_late_s
-        self.on_event = on_event
         self.stroke_watch = StrokeWatch()  # measuring once a control loop's backend measures its joints
-        self.events: BoundedLog[Event] = BoundedLog(keep_events)
         self.construction_s: BoundedLog[float] = BoundedLog(keep_events)
-        self._lock = threading.RLock()
-        self._queue: deque[GestureCommand] = deque()
         self.reset(self.neutral, 0.0)
 
     # -- public, thread-safe -------------------------------------------------------------------
@@ -62,15 +61,7 @@ class Sequencer:
             self._stroke_tick = -1
             self._hold_since = now
             self.stroke_watch.clear()
-
-    def submit(self, command: GestureCommand) -> None:
-        with self._lock:
-            self._queue.append(command)
-
-    def drop(self, command: GestureCommand, reason: str, now: float) -> None:
-        """Record a gesture the timeline could not fit (it is never queued)."""
-        with self._lock:
-            self._emit(now, EventKind.DROPPED, command, reason)
+            self.posture.reset()
 
     def interrupt(self, commands: list[GestureCommand] | tuple = (), now: float | None = None) -> None:
         """Clear pending actions; blend from the latest published pose to the first new command (or neutral).
@@ -86,20 +77,7 @@ class Sequencer:
                 first = commands[0]
                 self._start_blend(now, np.asarray(first.keyframes[0]), self.interrupt_blend_s, first)
             else:
-                self._start_blend(now, self.neutral, self.recover_s, None)
-
-    def retime(self, ids: set[int], delta: float) -> int:
-        """Move the queued commands in `ids` delta s later (their speech started late); how many moved."""
-        with self._lock:
-            moved = [k for k, command in enumerate(self._queue) if command.id in ids]
-            for k in moved:
-                self._queue[k] = replace(self._queue[k], release_at=self._queue[k].release_at + delta)
-            return len(moved)
-
-    @property
-    def pending(self) -> list[GestureCommand]:
-        with self._lock:
-            return list(self._queue)
+                self._start_blend(now, self._home(now), self.recover_s, None)
 
     @property
     def active(self) -> GestureCommand | None:
@@ -127,6 +105,7 @@ class Sequencer:
                 self._maybe_start(now)
             if self.state == State.HOLDING and now - self._hold_since >= self.hold_s:
                 self._recover(now)
+            self._follow_posture(now)
             return self.last.copy()
 
     def observe(self, now: float, measured: np.ndarray) -> None:
@@ -173,7 +152,7 @@ class Sequencer:
         late = (stroke_tick + due - 1 - self._stroke_tick) * dt
         if ahead and late > self.stall_stop_late_s:
             self._emit(now, EventKind.STOPPED, self._active, f"stall: stroke {late * 1e3:.0f} ms late")
-            self._start_blend(now, self.neutral, self.recover_s, None)
+            self._start_blend(now, self._home(now), self.recover_s, None)
             return False
         self._motion, self._index, self._motion_t0, self._stroke_tick = motion, 0, now - dt, stroke_tick
         return True
@@ -201,11 +180,12 @@ class Sequencer:
 
     def _begin(self, command: GestureCommand, now: float) -> bool:
         started = time.perf_counter()
+        keyframes = self.posture.retarget(command, self._home(now))
         if command.timed:
             times = np.asarray(command.offsets[1:]) + (command.release_at - now)
-            motion = self.builder.build_timed(command.keyframes, times, self.last, command.blend_in)
+            motion = self.builder.build_timed(keyframes, times, self.last, command.blend_in)
         else:
-            motion = self.builder.build(command.keyframes, command.duration, self.last)
+            motion = self.builder.build(keyframes, command.duration, self.last)
         self.construction_s.append(time.perf_counter() - started)
         reason = self.safety(motion.samples) if self.safety else None
         if reason is not None:
@@ -231,10 +211,25 @@ class Sequencer:
         self._set_state(now, State.BLENDING)
 
     def _recover(self, now: float) -> None:
-        if np.max(np.abs(self.last - self.neutral)) <= self.neutral_tolerance:
+        home = self._home(now)
+        if np.max(np.abs(self.posture.held(self.last) - home)) <= self.neutral_tolerance:
             self._set_state(now, State.IDLE)
         else:
-            self._start_blend(now, self.neutral, self.recover_s, None)
+            self._start_blend(now, home, self.recover_s, None)
+
+    def _home(self, now: float) -> np.ndarray:
+        """Between gestures the arms go to the current posture (a POSTURE event records a change)."""
+        if self.posture.stale:
+            self._emit(now, EventKind.POSTURE, None, self.posture.current)
+        return self.posture.home()
+
+    def _follow_posture(self, now: float) -> None:
+        """A changed posture is blended to once nothing runs or waits; the idle motion moves a settled arm."""
+        settled = self.state in (State.IDLE, State.HOLDING) and not self._queue
+        if self.posture.stale and (settled or self._recovering()):
+            self._start_blend(now, self._home(now), self.posture.settings.transition_s, None)
+            settled = False
+        self.last = self.posture.idle(self.last, now, settled)
 
     def _set_state(self, now: float, state: State) -> None:
         if state == State.HOLDING:
@@ -242,9 +237,3 @@ class Sequencer:
         if state != self.state:
             self.state = state
             self._emit(now, EventKind.STATE, None, state.value)
-
-    def _emit(self, now: float, kind: EventKind, command: GestureCommand | None, detail: str = "") -> None:
-        event = Event(now, kind, command.name if command else "", command.id if command else None, detail)
-        self.events.append(event)
-        if self.on_event is not None:
-            self.on_event(event)
