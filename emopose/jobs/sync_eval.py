@@ -3,8 +3,8 @@
 Each sequence-suite item becomes a turn whose reply is the item's text and whose plan is its
 annotated labels/anchors/variants (no planner, so only scheduling is measured). For each schedule mode
 (anchor: the paper's Eq. schedule; words: the engine's word onsets) the turn runs through resolve,
-modulate, schedule, sequence and dispatch on the configured backend (dry_run) with virtual time, and
-every released gesture is compared with the onset espeak reports for its trigger phrase:
+modulate, schedule, sequence and dispatch on dry_run with virtual time, and every released gesture is
+compared with the true onset of its trigger phrase (espeak's word events, or piper's alignments):
   scheduled vs onset: the schedule's release time (what the scheduler decided);
   actual vs onset:    the sequencer's "started" event (what the robot did): the 50 Hz tick grid adds
                       0..20 ms, and a gesture whose predecessor is still running waits for it to end
@@ -12,11 +12,9 @@ every released gesture is compared with the onset espeak reports for its trigger
   stroke vs onset:    where the executed stroke lands (emopose.sync.strokes.py): the first tick
                       at which the command stream, and with a simulator the joint stream, reaches the
                       gesture's stroke-start keyframe; this is the measure the timeline mode is built for.
-With job.plans=planner the configured planner plans each text instead of the annotation: strokes are then
-measured against the planner's own trigger (stroke vs trigger) and against the gold anchor of the act
-(stroke vs gold anchor, emopose/sync/affiliate.py): a trigger that starts at its clause lands its stroke
-on the trigger, but early for the words the gesture belongs to.
-A few items per mode are drawn as timelines (words, planned and executed strokes) into the run directory.
+With job.plans=planner the configured planner plans each text: strokes are then measured against its own
+trigger and the act's gold anchor (emopose/sync/affiliate.py; a clause-long trigger lands early for the
+words the gesture belongs to). A few items per mode are drawn as timelines into the run directory.
 """
 
 from __future__ import annotations
@@ -34,7 +32,6 @@ from emopose.contract import Plan
 from emopose.planners.base import PlanRequest
 from emopose.resources import Resources, Run
 from emopose.results import JobOutput, markdown_table
-from emopose.speech.espeak import EspeakSynthesizer
 from emopose.stages.parse import parse_output
 from emopose.sync.affiliate import gold_anchor_strokes
 from emopose.sync.plot import plot_timelines
@@ -46,7 +43,15 @@ from emopose.sync.strokes import (
     stroke_summary,
     unmet_targets,
 )
-from emopose.sync.words import GestureSync, annotated_spans, measure_turn, summarize
+from emopose.sync.words import (
+    GestureSync,
+    annotated_spans,
+    measure_turn,
+    require_true_onsets,
+    summarize,
+    true_word_events,
+    tts_settings,
+)
 from emopose.turn.pipeline import Pipeline
 from emopose.turn.runner import TurnRunner
 
@@ -66,9 +71,7 @@ class SyncEvalJob:
 
     def __call__(self, run: Run) -> JobOutput:
         res = run.resources
-        if not isinstance(res.synthesizer, EspeakSynthesizer):
-            raise ValueError(f"sync_eval measures against the engine's own word events, but tts is "
-                             f"{res.synthesizer.name!r}: run it with tts=espeak")
+        require_true_onsets(res.synthesizer)
         if res.clock.realtime:
             raise ValueError("sync_eval runs on virtual time: use backend=dry_run with run.clock=auto")
         if self.plans not in ("annotation", "planner"):
@@ -141,7 +144,7 @@ class SyncEvalJob:
         planned = SequenceItem(item.id, item.text, tuple(r.cls for r in plan.records),
                                tuple(r.trigger or "" for r in plan.records),
                                tuple(r.variant or "" for r in plan.records))
-        events = res.synthesizer.word_events(item.text)
+        events = true_word_events(res.synthesizer, turn.speech)
         sync = measure_turn(planned, turn, events)
         loop = runner.session.loop
         times = np.asarray(tap.times[first:]) + (loop.clock.now() - loop.stream_time)  # stream -> clock time
@@ -171,10 +174,9 @@ class SyncEvalJob:
             log.warning("say-do check: item %s record %d trigger %r is not in the reply",
                         m["item"], m["k"], m["trigger"])
         words_p95 = summaries.get("words", {}).get("scheduled_vs_onset", {}).get("p95_abs_ms")
-        speech = run.resources.synthesizer
         return {
             "suite": str(suite_path), "items": len(items), "plans": self.plans,
-            "tts": {"engine": speech.name, "voice": speech.voice, "rate": speech.rate},
+            "tts": tts_settings(run.resources.synthesizer),
             "control_dt_s": run.session.loop.dt, "modes": summaries,
             "target": {"words_p95_scheduled_vs_onset_ms": self.target_p95_ms, "value_ms": words_p95,
                        "met": words_p95 is not None and words_p95 <= self.target_p95_ms},
@@ -189,8 +191,7 @@ class SyncEvalJob:
         target, say_do = results["target"], results["say_do"]
         flagged = ", ".join(f"{m['item']}#{m['k']} {m['trigger']!r}" for m in say_do["records"]) or "none"
         return (f"# Speech-gesture sync ({results['items']} items from {results['suite']})\n\n"
-                f"True onsets: {results['tts']['engine']} word events (voice {results['tts']['voice']}, "
-                f"rate {results['tts']['rate']} wpm).\n\n"
+                f"True onsets: {', '.join(f'{k} {v}' for k, v in results['tts'].items())}.\n\n"
                 f"{_release_table(results['modes'])}\n\n"
                 "## Where the executed strokes land\n\nExecuted stroke start: the first tick at which the "
                 "stream comes within 0.05 rad of the gesture's stroke-start keyframe; offset from the "

@@ -18,7 +18,36 @@ import numpy as np
 from emopose import CONTROL_DT
 from emopose.bench.suites import SequenceItem
 from emopose.contract import EventKind, trigger_position
+from emopose.speech.clip import SpeechClip
+from emopose.speech.espeak_lib import WordEvent
 from emopose.speech.word_events import clean_events, onset_of_span
+
+TRUE_ONSET_ENGINES = ("espeak", "piper")  # engines whose word onsets are measured, not estimated
+
+
+def require_true_onsets(synthesizer) -> None:
+    if synthesizer.name not in TRUE_ONSET_ENGINES:
+        raise ValueError(f"sync_eval measures against true word onsets, but tts is {synthesizer.name!r} "
+                         f"(estimated onsets): run it with tts=espeak or tts=piper")
+
+
+def tts_settings(synthesizer) -> dict:
+    """What the onsets came from, for results.json: the engine and its voice settings."""
+    if synthesizer.name == "piper":
+        return {"engine": "piper", "voice": synthesizer.model_id, "length_scale": synthesizer.length_scale}
+    return {"engine": synthesizer.name, "voice": synthesizer.voice, "rate": synthesizer.rate}
+
+
+def true_word_events(synthesizer, clip: SpeechClip) -> tuple[WordEvent, ...]:
+    """The true word onsets of a clip that played: espeak's own word events, or piper's onsets from its
+    phoneme alignments (the clip's words: piper samples anew each render, so only the played clip counts)."""
+    require_true_onsets(synthesizer)
+    if synthesizer.name == "espeak":
+        return synthesizer.word_events(clip.text)
+    if clip.estimated:
+        raise ValueError(f"{synthesizer.name} gave no alignments for {clip.text[:60]!r}: its onsets are "
+                         "estimated, so sync_eval cannot measure against them")
+    return tuple(WordEvent(w.char_start, w.char_end - w.char_start, w.start_s) for w in clip.words)
 
 
 def annotated_spans(text: str, anchors: tuple[str, ...]) -> list[tuple[int, int] | None]:

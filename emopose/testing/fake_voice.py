@@ -62,6 +62,21 @@ def add_voice_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--mic-delay", type=float, default=0.5, help="seconds after READY before streaming")
 
 
+def heard_at(rows: list[dict], stream_id: str, seconds: float) -> float | None:
+    """When the modelled buffer sounds the audio `seconds` into stream `stream_id`, from the log's rows (its
+    `t` is time.monotonic(), the clock of emopose.clock.MonotonicClock): a chunk starts sounding at its
+    arrival plus the audio queued ahead of it (ahead_s; < 0: the robot ran dry and it sounds on arrival).
+    None: that part of the stream never arrived, or a stop cut it before it sounded."""
+    byte = 2 * int(seconds * PCM_BYTES_PER_SECOND / 2)
+    stops = [r["t"] for r in rows if r["kind"] == "voice_stop" and r["stream_id"] == stream_id]
+    for row in rows:
+        if (row["kind"] == "voice_chunk" and row["stream_id"] == stream_id
+                and row["offset"] <= byte < row["offset"] + row["bytes"]):
+            sounds = row["t"] + max(row["ahead_s"], 0.0) + (byte - row["offset"]) / PCM_BYTES_PER_SECOND
+            return None if stops and stops[0] <= sounds else sounds
+    return None
+
+
 class FakeVoice:
     def __init__(self, session: DdsSession, args: argparse.Namespace, log: Callable[[dict], None],
                  forced_codes: dict[int, int]) -> None:

