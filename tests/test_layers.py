@@ -18,6 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[1] / "emopose"
 # sub-layers matters too: the LLM client and speech sit below the planners, which may use both.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("base", ("emopose", "emopose.config", "emopose.robot", "emopose.clock", "emopose.child_process",
+              "emopose.background_call",
               "emopose.recording", "emopose.recording_schemas", "emopose.recover", "emopose.results",
               "emopose.sentences", "emopose.scene")),
     ("know: contract", ("emopose.contract", "emopose.joint_limits", "emopose.library")),

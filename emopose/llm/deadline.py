@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import asyncio
 import re
-import threading
 from collections.abc import Awaitable, Callable
 from typing import TypeVar
+
+from emopose.background_call import BackgroundCall
 
 T = TypeVar("T")
 
@@ -36,21 +37,10 @@ def _late(timeout_s: float) -> CallTimeout:
 
 def call_within(call: Callable[[], T], timeout_s: float) -> T:
     """call() in a daemon thread; its result, or CallTimeout once timeout_s has passed."""
-    done, outcome = threading.Event(), {}
-
-    def run() -> None:
-        try:
-            outcome["value"] = call()
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller below
-            outcome["error"] = exc
-        done.set()
-
-    threading.Thread(target=run, name="llm-call", daemon=True).start()
-    if not done.wait(timeout_s):
+    background = BackgroundCall(call, "llm-call")
+    if not background.done.wait(timeout_s):
         raise _late(timeout_s)
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome["value"]
+    return background.result()
 
 
 async def await_within(call: Awaitable[T], timeout_s: float) -> T:

@@ -1,10 +1,12 @@
-"""HTTP API of the live robot: info, status, turns (typed or spoken), named gestures, interrupt, audio.
+"""HTTP API of the live robot: info, status, turns (typed or spoken), named gestures, interrupt, cancel a
+line being planned, audio, and the session's recording report (made in a child process).
 
 The WebSocket carries the same actions for the page; these routes serve scripts and tests.
 """
 
 from __future__ import annotations
 
+import asyncio
 import tempfile
 from pathlib import Path
 
@@ -15,7 +17,8 @@ from emopose.contract import GestureRecord
 from emopose.speech.asr import ASRError
 from emopose.stages.parse import MAX_SPOKEN_CHARS
 from emopose.stages.resolve import resolve_record
-from emopose.web.schemas import GestureRequest, ResolveRequest, SayRequest
+from emopose.web.report import ReportFailed, ReportUnavailable
+from emopose.web.schemas import CancelRequest, GestureRequest, ResolveRequest, SayRequest
 from emopose.web.session import LiveSession, UnknownMotion
 
 router = APIRouter(prefix="/api")
@@ -76,6 +79,36 @@ def resolve(body: ResolveRequest, request: Request) -> dict:
 @router.post("/interrupt")
 def interrupt(request: Request) -> dict:
     return session_of(request).interrupt()
+
+
+@router.post("/cancel")
+def cancel(body: CancelRequest, request: Request) -> dict:
+    """Abandon the planner call of the line being planned: the turn ends as turn_cancelled."""
+    return session_of(request).pending.cancel(body.turn)
+
+
+@router.get("/report")
+def report_info(request: Request) -> dict:
+    return session_of(request).report.info()
+
+
+@router.post("/report")
+async def make_report(request: Request) -> dict:
+    """The recording report on this session's recording as it is now (seconds to minutes)."""
+    try:
+        return await asyncio.to_thread(session_of(request).report.make)
+    except ReportUnavailable as exc:
+        raise HTTPException(409, str(exc)) from exc
+    except ReportFailed as exc:
+        raise HTTPException(500, str(exc)) from exc
+
+
+@router.get("/report/{name}")
+def report_file(name: str, request: Request) -> FileResponse:
+    path = session_of(request).report.file(name)  # only the newest report's files, never a client path
+    if path is None or not path.is_file():
+        raise HTTPException(404, f"no report file {name!r}: make the report first (POST /api/report)")
+    return FileResponse(path)
 
 
 @router.get("/audio/{turn_id}")

@@ -2,9 +2,10 @@
 
 The page's log keeps only the newest serve.max_turns_kept messages. The tally sees every message the
 session publishes: it counts turns by kind and plan source (fallbacks and failed planner calls apart),
-replies stopped early, interrupts and cues that did not run, and appends one row per turn (and one per
-late cue outcome) to turns.jsonl in the run directory as it happens, so memory stays flat however long
-the session runs. results.md tables the rows (the newest MAX_TABLE_ROWS; turns.jsonl has them all).
+replies stopped early, interrupts, lines cancelled while planned and cues that did not run, and appends
+one row per turn (and one per cancelled line, and one per late cue outcome) to turns.jsonl in the run
+directory as it happens, so memory stays flat however long the session runs. results.md tables the rows
+(the newest MAX_TABLE_ROWS; turns.jsonl has them all).
 SOURCE_WORDS says each plan source in words a visitor reads (the page gets it in /api/info).
 """
 
@@ -54,6 +55,9 @@ class TurnTally:
             elif kind == "cue_outcome":
                 self.events["cues_not_performed"] += 1
                 self._append({"turn": message["turn_id"], "late_outcome": message["outcome"]["kind"]})
+            elif kind == "turn_cancelled":  # a row, but not a turn: nothing was said or done
+                self.events[kind] += 1
+                self._append(cancelled_row(message))
             elif kind in ("reply_stopped", "interrupted"):
                 self.events[kind] += 1
 
@@ -72,7 +76,7 @@ class TurnTally:
             return {"turns": self.turns, "kinds": dict(self.kinds), "sources": dict(self.sources),
                     "fallbacks": fallbacks, "planner_failures": self.sources.get("call_failed", 0),
                     "replies_stopped": self.events["reply_stopped"],
-                    "interrupts": self.events["interrupted"],
+                    "interrupts": self.events["interrupted"], "cancelled": self.events["turn_cancelled"],
                     "cues_not_performed_late": self.events["cues_not_performed"],
                     "turns_file": None if self.rows_path is None else self.rows_path.name}
 
@@ -101,6 +105,13 @@ def turn_row(message: dict) -> dict:
             "fallback": "yes" if message["source"] not in USABLE_SOURCES else "",
             "cues": len(cues), "not run": sum(c["outcome"] is not None for c in cues),
             "planner s": round(message["planner_latency_s"], 2),
+            "utterance": _cell(message["utterance"], 48)}
+
+
+def cancelled_row(message: dict) -> dict:
+    """A line cancelled while it was planned, as a table row (its planning time so far)."""
+    return {"turn": message["turn_id"], "kind": "say", "plan source": "cancelled while planning",
+            "fallback": "", "cues": 0, "not run": 0, "planner s": round(message["planning_s"], 2),
             "utterance": _cell(message["utterance"], 48)}
 
 
