@@ -6,6 +6,9 @@
                      the .txt file with the same stem, where present; results hold each item's WER and
                      the overall WER (errors summed over all reference words) and real-time factor.
 A file that cannot be transcribed becomes an item with its `error` (a folder run goes on).
+  audio=PATH job.barge_in_at_s=S job.barge_in_audio=PATH2
+                     the visitor interrupts the reply S seconds into its audio with a second recording:
+                     barge-in latency, the second turn, VAD end -> first audio (listen_barge_in.py).
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from emopose.jobs.listen_barge_in import barge_in_turns
 from emopose.resources import Run
 from emopose.results import JobOutput, markdown_table
 from emopose.speech.asr import ASRError
@@ -24,6 +28,9 @@ from emopose.speech.whisper_asr import Transcript, WhisperTranscriber
 class ListenJob:
     audio: str | None = None
     audio_dir: str | None = None
+    barge_in_at_s: float | None = None  # with barge_in_audio: the visitor interrupts the reply
+    barge_in_audio: str | None = None
+    echo_gain: float = 0.25             # the robot's reply at its microphone: -12 dB
 
     def __call__(self, run: Run) -> JobOutput:
         asr = run.resources.asr
@@ -32,6 +39,10 @@ class ListenJob:
             raise ValueError(f"listen needs word timestamps from asr=whisper, but asr is {name!r}")
         if (self.audio is None) == (self.audio_dir is None):
             raise ValueError("listen takes one of audio=PATH.wav or job.audio_dir=DIR")
+        if (self.barge_in_at_s is None) != (self.barge_in_audio is None) or (
+                self.barge_in_at_s is not None and (self.audio is None or self.barge_in_at_s < 0)):
+            raise ValueError("a barge-in takes audio=PATH.wav, job.barge_in_at_s >= 0 (seconds into the "
+                             "reply's audio) and job.barge_in_audio=PATH.wav (the visitor's 2nd recording)")
         if self.audio_dir:
             return transcribe_folder(asr, Path(self.audio_dir))
         return self._one(run, asr, Path(self.audio))
@@ -40,6 +51,8 @@ class ListenJob:
         heard = asr.transcribe_detail(path)
         if not heard.text:
             raise ASRError(f"{path.name}: no speech recognised ({'; '.join(heard.warnings) or 'empty'})")
+        if self.barge_in_at_s is not None:
+            return self._barge_in(run, asr, path, heard)
         turn = run.runner.run(heard.text)
         data = turn.to_json()
         results = {"file": str(path), **_heard(heard), "reply": turn.plan.reply,
@@ -47,6 +60,19 @@ class ListenJob:
                    "stage_ms": data["stage_ms"], "turn": data}
         text = (f"Heard ({heard.duration_s:.1f} s of audio, {heard.asr_s * 1000:.0f} ms): {heard.text}\n"
                 f"Reply: {turn.plan.reply}\nStage ms: {data['stage_ms']}")
+        return results, text
+
+
+    def _barge_in(self, run: Run, asr: WhisperTranscriber, path: Path, heard: Transcript) -> JobOutput:
+        found = barge_in_turns(run, asr, heard.text, Path(self.barge_in_audio), self.barge_in_at_s,
+                               self.echo_gain)
+        results = {"file": str(path), **_heard(heard), "planner": run.resources.planner.name, **found}
+        stops = found["barge_ins"]
+        text = (f"Heard: {heard.text}\nReply: {found['reply']}\n"
+                + (f"Barge-in: the robot stopped {stops[0]['stopped_after_voice_ms']:.0f} ms after the "
+                   "visitor's voice began" if stops else "No barge-in detected")
+                + (f"\nSecond turn: {found['second']['transcript']} -> {found['second'].get('reply')}"
+                   if "second" in found else ""))
         return results, text
 
 

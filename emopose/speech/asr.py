@@ -39,6 +39,7 @@ def existing_audio_file(audio: str | Path) -> Path:
 class Recognizer(ABC):
     name = "base"
     accepts_audio = True  # False: typed text only (the web page then hides its microphone)
+    listening: dict = {}  # how a live session hears the visitor: asr.listening (speech/listening.py)
 
     def utterance(self, text: str | None = None, audio: str | Path | None = None) -> str:
         """Typed text wins; otherwise the transcript of `audio`."""
@@ -71,7 +72,8 @@ class LitellmTranscriber(Recognizer):
 
     def __init__(self, model: str = "openai/whisper-1", api_base: str | None = None,
                  api_key: str | None = None, language: str | None = "en", prompt: str | None = None,
-                 timeout_s: float = 30.0) -> None:
+                 timeout_s: float = 30.0, listening: dict | None = None) -> None:
+        self.listening = dict(listening or {})
         if not model:
             raise ValueError("asr.model is empty: name a litellm transcription model, e.g. openai/whisper-1")
         self.model, self.api_base, self.api_key = model, api_base, api_key

@@ -27,7 +27,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from emopose.speech.audio_in import SAMPLE_RATE
-from emopose.speech.vad import CHUNK_BYTES, VoiceActivity
+from emopose.speech.vad import CHUNK_BYTES, SpeechEvent, VoiceActivity
 from emopose.speech.wav import write_wav
 
 log = logging.getLogger(__name__)
@@ -134,8 +134,12 @@ class Utterances:
         self.count = 0
 
     def feed(self, pcm: bytes) -> None:
+        self.take(pcm, self.vad.feed(pcm))
+
+    def take(self, pcm: bytes, events: list[SpeechEvent]) -> None:
+        """PCM and the events its VAD (fed by someone else: a BargeIn) reported for it."""
         self._pcm += pcm
-        for event in self.vad.feed(pcm):
+        for event in events:
             if event.kind == "start":
                 self._drop(max(0, self._byte_at(event.t_s) - self.pad_bytes))
             else:

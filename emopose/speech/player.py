@@ -28,18 +28,23 @@ log = logging.getLogger(__name__)
 
 
 class Player:
-    def __init__(self, sink: str = "auto", latency_s: float = 0.08, command: list[str] | None = None) -> None:
+    def __init__(self, sink: str = "auto", latency_s: float = 0.08, command: list[str] | None = None,
+                 light: bool = True) -> None:
+        """`light`: with a G1 connected (backend=g1 or player=g1) its chest light shows the live session's
+        state (emopose/turn/state_light.py); false leaves the light alone."""
         if sink not in ("auto", "none"):
             raise ValueError(f"player.sink must be auto or none, got {sink!r}")
         if latency_s < 0:
             raise ValueError(f"player.latency_s must be >= 0, got {latency_s}")
         self.sink, self.latency_s, self.command = sink, float(latency_s), list(command or [])
+        self.light = bool(light)
         self._device: list[str] | object | None | bool = None  # None: not probed yet; False: none/failed
         self._process: subprocess.Popen | None = None
         self._lock = threading.Lock()
         self._generation = 0  # bumped by stop(): a clip scheduled to follow checks it before it starts
         self.started_at: float | None = None
         self.ends_at: float | None = None
+        self.clip: SpeechClip | None = None  # the clip started last (the echo gate's reference)
         self.last_sink = "none"
 
     # -- public --------------------------------------------------------------------------------
@@ -52,7 +57,7 @@ class Player:
             start = self._start_device(clip, clock)
             if start is None:
                 self.last_sink, start = "none", clock.now()
-        self.started_at, self.ends_at = start, start + clip.duration_s
+        self.clip, self.started_at, self.ends_at = clip, start, start + clip.duration_s
         return start
 
     def expected_latency_s(self, clip: SpeechClip, clock: Clock) -> float:

@@ -58,7 +58,9 @@ class WhisperTranscriber(Recognizer):
 
     def __init__(self, model: str = PACKAGED, language: str | None = "en", compute_type: str = "int8",
                  cpu_threads: int = 2, beam_size: int = 1, word_timestamps: bool = True,
-                 max_duration_s: float = 120.0, prompt: str | None = None) -> None:
+                 max_duration_s: float = 120.0, prompt: str | None = None,
+                 listening: dict | None = None) -> None:
+        self.listening = dict(listening or {})
         if model.endswith(".en") and language not in (None, "en"):
             raise ValueError(f"asr.model {model} is English-only but asr.language is {language!r}: "
                              "set asr.language=en, or use a multilingual model folder")

@@ -14,13 +14,14 @@ silence() is the one way to stop talking and clear the gestures (an interrupt, a
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
-from contextlib import ExitStack, nullcontext
+from collections.abc import Callable, Iterator
+from contextlib import ExitStack, contextmanager, nullcontext
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
 
 from emopose.contract import Plan
+from emopose.execution.posture import THINKING
 from emopose.llm.errors import LLMCallError
 from emopose.planners.base import Planner, PlanRequest
 from emopose.planners.streaming import SentencePlans, StreamingPlanner
@@ -29,6 +30,7 @@ from emopose.sync.recording import TIMELINE, speech_timeline
 from emopose.turn.dialogue import Dialogue
 from emopose.turn.model import ResolvedGesture, Turn
 from emopose.turn.pipeline import Pipeline, PipelineError, Stage
+from emopose.turn.planning_call import AbandonableCall
 from emopose.turn.session import Session
 from emopose.turn.stream_pipelines import StreamPipelines
 from emopose.turn.thinking import ThinkingGesture
@@ -47,6 +49,8 @@ class TurnRunner:
         self.dialogue.on_message = self.session.write  # each message once, on /dialogue
         self._stream: SentencePlans | None = None  # the reply streaming now, for cancel()
         self._stream_lock = threading.Lock()
+        self._planner_call = AbandonableCall()  # the planner call under way, for cancel_planning()
+        self._planning = 0  # planner calls under way (the chest light's "thinking")
 
     def with_pipeline(self, pipeline: Pipeline) -> TurnRunner:
         """The same runner (session, planner, dialogue) running other stages: a suite's variant."""
@@ -67,6 +71,20 @@ class TurnRunner:
         if remember:
             self.dialogue.exchange(utterance, turn.plan.reply)
         return turn
+
+    @property
+    def planning(self) -> bool:
+        """True while a planner call (or a streamed reply's first sentence) is under way. Any thread."""
+        return self._planning > 0
+
+    @contextmanager
+    def _planning_now(self) -> Iterator[None]:
+        self._planning += 1
+        try:
+            with self.session.loop.sequencer.posture.holding(THINKING):  # the arms between gestures
+                yield
+        finally:
+            self._planning -= 1
 
     @property
     def streams(self) -> bool:
@@ -115,6 +133,11 @@ class TurnRunner:
         if plans is not None:
             plans.cancel()
 
+    def cancel_planning(self) -> bool:
+        """Abandon the planner call under way, from any thread: its turn raises PlanningCancelled (the
+        thinking gesture stops, nothing joins the dialogue) and the answer is dropped. False: no call was."""
+        return self._planner_call.abandon()
+
     def silence(self) -> None:
         """Stop talking and clear the gestures now, from any thread: a reply still streaming stops first (no
         sentence after this one), the audio stops, and the arms blend from where they are toward neutral."""
@@ -131,6 +154,7 @@ class TurnRunner:
     def _perform(self, request: PlanRequest, plans: SentencePlans, reply: StreamedReply,
                  on_turn: Callable[[Turn], None]) -> None:
         with ExitStack() as thinking:
+            thinking.enter_context(self._planning_now())
             if self.thinking is not None:
                 thinking.enter_context(self.thinking.around_planning())
             for output in plans:
@@ -173,8 +197,9 @@ class TurnRunner:
 
     def plan(self, turn: Turn, planner: Planner) -> None:
         """The planner call, wrapped in the thinking gesture that masks its latency."""
-        with self.thinking.around_planning() if self.thinking is not None else nullcontext():
-            turn.planner_output = planner.plan(turn.request)
+        thinking = self.thinking.around_planning() if self.thinking is not None else nullcontext()
+        with self._planning_now(), thinking:
+            turn.planner_output = self._planner_call.run(lambda: planner.plan(turn.request))
         turn.stage_s["planner"] = turn.planner_output.latency_s
         self._record(turn, "planner_output")
 

@@ -45,6 +45,7 @@ class DraftRequest(_Strict):
     motion_type: Literal["sequence", "pose"] = "sequence"
     duration: float | None = Field(default=None, gt=0.0, le=20.0)  # None: Eq. duration
     stroke: tuple[int, int] | None = None  # sync points; None: the documented default (largest excursion)
+    times: list[float] | None = Field(default=None, max_length=14)  # per keyframe; None: evenly spaced
     intensity: Intensity = 3
 
 
@@ -68,6 +69,7 @@ class SaveRequest(_Strict):
     motion_type: Literal["sequence", "pose"] = "sequence"
     duration: float | None = Field(default=None, gt=0.0, le=20.0)
     stroke: tuple[int, int] | None = None
+    times: list[float] | None = Field(default=None, max_length=14)
     keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
     overwrite: bool = Field(default=False, strict=True)
 
@@ -75,6 +77,10 @@ class SaveRequest(_Strict):
         """The library-file mapping (what MotionLibrary.save validates)."""
         data = self.model_dump(by_alias=True, exclude={"overwrite"}, exclude_none=True)
         return data
+
+
+class CancelRequest(_Strict):
+    turn: int | None = Field(default=None, ge=1, strict=True)  # the turn_started message's id; None: any
 
 
 class RenameRequest(_Strict):
@@ -94,9 +100,19 @@ class InterruptMessage(_Strict):
     type: Literal["interrupt"]
 
 
+class CancelMessage(CancelRequest):
+    type: Literal["cancel"]
+
+
+class ListeningMessage(_Strict):
+    type: Literal["listening"]
+    active: bool = Field(default=True, strict=True)  # the visitor started (true) or gave up (false) a line
+
+
 class PingMessage(_Strict):
     type: Literal["ping"]
 
 
-ClientMessage = Annotated[SayMessage | GestureMessage | InterruptMessage | PingMessage,
+ClientMessage = Annotated[SayMessage | GestureMessage | InterruptMessage | CancelMessage | ListeningMessage
+                          | PingMessage,
                           Field(discriminator="type")]

@@ -25,18 +25,22 @@ import numpy as np
 
 from emopose.backends.capabilities import SimulatedState
 from emopose.contract import GestureRecord, LibraryEntry, Plan
-from emopose.planners.base import ModalPlanner, PlannerMode
 from emopose.resources import Run
 from emopose.stages.parse import MAX_SPOKEN_CHARS
 from emopose.studio.authoring import PoseStudio
 from emopose.turn.dialogue import HistoryWindow
 from emopose.turn.model import ResolvedGesture, Turn
+from emopose.turn.planning_call import PlanningCancelled
+from emopose.turn.runner import StreamedReply
 from emopose.web.clients import Clients
 from emopose.web.cue_outcomes import CueOutcomes, remember
+from emopose.web.planning import PendingPlan, cancelled, narrates
+from emopose.web.report import SessionReport
 from emopose.web.serve_tally import SOURCE_WORDS, TurnTally, failure_banner
 from emopose.web.settings import ServeSettings
 from emopose.web.stick_figure import stick_figure
 from emopose.web.turns import summarize_turn
+from emopose.web.voice_io import VoiceIO
 
 SHARED_STATE_S = 0.04  # pages share a state this fresh (the stick figure's kinematics cost ~3 ms)
 
@@ -62,7 +66,10 @@ class LiveSession:
         self.clients = Clients(settings)
         self.tally = TurnTally(run.session.run_dir / "turns.jsonl")
         self.planner_failure: dict | None = None  # the newest planned turn's failed call, for a banner
+        self.pending = PendingPlan(run.runner)  # the line being planned: its time, retries and Cancel
+        self.report = SessionReport(run.session.run_dir, run.session.record, res.library.limits)
         run.runner.dialogue.window = HistoryWindow(settings.history_turns, settings.history_tokens)
+        self.voice = VoiceIO(self)  # the microphone (VAD, barge-in) and the G1's chest light
 
     # -- turns (called from the event loop; the work runs on the worker thread) ----------------
     async def say(self, text: str, image: bytes | None = None) -> dict:
@@ -87,9 +94,22 @@ class LiveSession:
         return await asyncio.get_running_loop().run_in_executor(self._worker, fn, *args)
 
     def _say(self, text: str, image: bytes | None) -> dict:
-        self.publish({"type": "turn_started", "utterance": text})
+        started = self.publish({"type": "turn_started", "utterance": text})
+        self.pending.begin(started)
         published: list[dict] = []
-        reply = self.run.runner.respond(text, image, lambda t: published.append(self._publish_turn(t, "say")))
+
+        def on_turn(turn: Turn) -> None:
+            published.append(self._publish_turn(turn, "say"))
+            self.pending.end(started)
+
+        try:
+            reply = self.run.runner.respond(text, image, on_turn)
+        except PlanningCancelled:
+            reply = StreamedReply([], cancelled=True)
+        finally:
+            self.pending.end(started)
+        if reply.cancelled and not published:  # nothing said or done; out of the dialogue; counted
+            return self.publish(cancelled(started, next(self._turn_ids), self.res.clock.now()))
         whole = published and reply.error is None and not reply.cancelled
         stopped = {"type": "reply_stopped", "error": reply.error, "cancelled": reply.cancelled}
         return published[-1] if whole else self.publish({**stopped, "sentences": len(published)})
@@ -127,6 +147,23 @@ class LiveSession:
             if failed:
                 self.publish(self.planner_failure)
         return message
+
+    def hear(self, pcm: bytes) -> bool:
+        """The page's microphone (16 kHz mono int16); False when this session does not listen."""
+        return self.voice.hear(pcm)
+
+    def say_heard(self, audio_path: Path) -> None:
+        """An utterance the microphone's VAD ended: transcribed and said on the turn worker, in order."""
+        self._worker.submit(self._say_heard, audio_path)
+
+    def _say_heard(self, audio_path: Path) -> None:
+        try:
+            text = self.res.asr.utterance(audio=audio_path)
+            if text:
+                self._say(text, None)
+        except Exception as exc:  # noqa: BLE001 - no page waits on this turn: every page hears why
+            problem = f"spoken turn failed: {type(exc).__name__}: {exc}"
+            self.publish({"type": "error", "message": problem[:300]})
 
     def interrupt(self) -> dict:
         self.run.runner.silence()
@@ -183,6 +220,7 @@ class LiveSession:
                                                       **session.loop.stats.summary()},
             "library_version": self.res.library.version, "stick": stick_figure(self.pose()[0]),
             "clients": self.clients.counters(), "planner_failure": self.planner_failure,
+            "planning": self.pending.state(),  # the line being planned: since when, retries so far
         }
 
     def info(self) -> dict:
@@ -197,9 +235,11 @@ class LiveSession:
             "narrates": narrates(self.res.planner),  # the page's mode hint before the first turn
             "limits": {"utterance_chars": MAX_SPOKEN_CHARS, "max_clients": self.settings.max_clients},
             "history": {"turns": self.settings.history_turns, "tokens": self.settings.history_tokens},
+            "report": self.report.info(),  # this session's recording and the command that reports on it
         }
 
     def close(self) -> None:
+        self.voice.close()
         self._worker.shutdown(wait=True, cancel_futures=True)
         if self.frames is not None:
             self.frames.stop()
@@ -208,8 +248,3 @@ class LiveSession:
         if self.renderer is not None:
             self.renderer.close()
 
-
-def narrates(planner) -> bool:
-    """Whether the robot says the visitor's text (narrate) or the planner writes a reply: planners without a
-    mode (the local and keyword ones) only choose gestures for the words they are given."""
-    return planner.mode is PlannerMode.NARRATE if isinstance(planner, ModalPlanner) else True

@@ -1,4 +1,7 @@
-"""The page's WebSocket: actions in (say, gesture, interrupt), live state and frames out.
+"""The page's WebSocket: actions in (say, gesture, interrupt, cancel), live state and frames out.
+
+A binary message from the page is its microphone, 16 kHz mono int16 PCM (any length): it goes to the
+session's Listener (emopose/web/voice_io.py: VAD, barge-in, an utterance per VAD end).
 
 Receiving and sending run side by side: a turn is started as a task, so an interrupt sent while the
 planner works is handled at once. The sender pushes, each cycle, every new broadcast-log message (turns,
@@ -16,14 +19,24 @@ import logging
 from fastapi import APIRouter, WebSocket, WebSocketDisconnect
 from pydantic import TypeAdapter, ValidationError
 
+from emopose.execution.posture import LISTENING, REST
 from emopose.web.api import camera_image
 from emopose.web.clients import REFUSED_CODE, Pacer
-from emopose.web.schemas import ClientMessage, GestureMessage, InterruptMessage, SayMessage
+from emopose.web.schemas import (
+    CancelMessage,
+    ClientMessage,
+    GestureMessage,
+    InterruptMessage,
+    ListeningMessage,
+    SayMessage,
+)
 from emopose.web.session import LiveSession, UnknownMotion
 
 log = logging.getLogger(__name__)
 router = APIRouter()
 _messages = TypeAdapter(ClientMessage)
+_NOT_LISTENING = {"type": "error", "message": "binary messages are microphone audio, and this server does "
+                  "not listen: run with asr=whisper (or asr=litellm)"}
 
 
 @router.websocket("/ws")
@@ -51,7 +64,10 @@ async def _serve_page(websocket: WebSocket, session: LiveSession) -> None:
             message = await websocket.receive()
             if message["type"] == "websocket.disconnect":
                 break
-            reply = await _handle(session, message.get("text"), tasks, websocket)
+            if message.get("bytes") is not None:  # the page's microphone: 16 kHz mono int16 PCM
+                reply = None if session.hear(message["bytes"]) else _NOT_LISTENING
+            else:
+                reply = await _handle(session, message.get("text"), tasks, websocket)
             if reply is not None:
                 await websocket.send_json(reply)
     except WebSocketDisconnect:
@@ -76,6 +92,12 @@ async def _handle(session: LiveSession, text: str | None, tasks: set, websocket:
     if isinstance(message, InterruptMessage):
         session.interrupt()
         return None
+    if isinstance(message, ListeningMessage):  # the visitor types: the listening posture (posture.py)
+        session.res.sequencer.posture.request(LISTENING if message.active else REST)
+        return None
+    if isinstance(message, CancelMessage):  # a cancelled line reaches every page as turn_cancelled
+        answer = session.pending.cancel(message.turn)
+        return None if answer["cancelled"] else {"type": "cancel_refused", "message": answer["reason"]}
     if isinstance(message, SayMessage):
         image = camera_image(session) if message.attach_camera else None
         action = session.say(message.text, image)

@@ -43,8 +43,10 @@ class G1Player(Player):
     def __init__(self, latency_s: float = 0.25, lead_s: float = 0.3, chunk_s: float = 0.1,
                  app_name: str = "emopose", volume: int | None = None, fallback: str = "auto",
                  retry_s: float = 10.0, domain_id: int = 0, network_interface: str | None = None,
-                 service: str = VOICE_SERVICE, timeout_s: float = 1.0) -> None:
-        super().__init__(sink="auto", latency_s=latency_s)
+                 service: str = VOICE_SERVICE, timeout_s: float = 1.0, light: bool = True,
+                 light_colours: dict | None = None) -> None:
+        super().__init__(sink="auto", latency_s=latency_s, light=light)
+        self.light_colours = {k: tuple(v) for k, v in (light_colours or {}).items()}  # chest_light.COLOURS
         if fallback not in FALLBACKS:
             raise ValueError(f"player.fallback must be one of {FALLBACKS}, got {fallback!r}")
         if not 0.02 <= chunk_s <= 1.0 or lead_s <= 0 or retry_s < 0:
@@ -71,6 +73,7 @@ class G1Player(Player):
             start = self.fallback.play(clip, clock, follow)
             host = self.fallback
             self.last_sink, self.started_at, self.ends_at = host.last_sink, host.started_at, host.ends_at
+            self.clip = clip
             return start
         return super().play(clip, clock, follow)
 

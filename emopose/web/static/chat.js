@@ -1,17 +1,17 @@
 // The chat page: dialogue history with timed cues, the composer, and the live robot panel.
 import { api, connect, el, fillBadges } from "./common.js";
 import { markOutcome, markStroke, ReplyPlayer, setSourceWords, showFailure, showPlayed, turnBubble } from "./cues.js";
+import { cancelledNote, PlanningBubble } from "./planning.js";
+import { ReportPanel } from "./report.js";
 import { RobotPanel } from "./robot.js";
 
 const $ = (id) => document.getElementById(id);
 const history = $("history");
 const robot = new RobotPanel();
 let players = [];
-let pending = null;
 let replyOpen = false; // a streamed reply arrives sentence by sentence: its turns play one after another
 let libraryVersion = null;
 let plannerName = "";
-let planningTimer = null;
 
 // Narration planners (keyword, local, llm mode=narrate) speak the user's text as the robot's line. The
 // server says which kind it runs (hello.narrates); a server that does not say is not guessed for: the
@@ -37,21 +37,7 @@ function showCount() {
   $("say-count").classList.toggle("late", used >= input.maxLength);
 }
 
-// "planning… 3.4 s": the pending bubble counts from when the server started the turn.
-function showPlanning(msg) {
-  clearPlanning();
-  const started = performance.now() - Math.max(0, (msg.now ?? msg.server_now) - msg.server_now) * 1000;
-  pending = el("div", { class: "bubble robot pending", text: "planning…" });
-  const tick = () => { pending.textContent = `planning… ${((performance.now() - started) / 1000).toFixed(1)} s`; };
-  tick();
-  planningTimer = setInterval(tick, 100);
-  history.append(pending);
-}
-
-function clearPlanning() {
-  clearInterval(planningTimer);
-  if (pending) { pending.remove(); pending = null; }
-}
+function clearPlanning() { planning.clear(); }
 
 function showError(message) {
   const banner = $("error");
@@ -91,7 +77,10 @@ function onMessage(msg) {
       $("attach-wrap").classList.toggle("hidden", !msg.channels.camera);
       history.replaceChildren();
       setSourceWords(msg.sources);
-      msg.log.filter((m) => m.type === "turn").forEach((t) => addTurn(t, false)); // outcomes are in the turns
+      msg.log.forEach((m) => { // outcomes are in the turns
+        if (m.type === "turn") addTurn(m, false);
+        else if (m.type === "turn_cancelled") showCancelled(m);
+      });
       msg.log.filter((m) => m.type === "planner_failed").forEach(onFailure);
       plannerName = msg.planner;
       showMode(msg.narrates ?? msg.log.filter(tellsMode).map((t) => t.narrated).pop());
@@ -102,7 +91,7 @@ function onMessage(msg) {
       replyOpen = false;
       history.append(userBubble(msg.utterance));
       history.lastElementChild.setAttribute("data-utterance", ""); // addTurn will not repeat it
-      showPlanning(msg);
+      planning.show(msg);
       scrollDown();
       break;
     case "turn": addTurn(msg, true); if (tellsMode(msg)) showMode(msg.narrated); break;
@@ -111,6 +100,8 @@ function onMessage(msg) {
       $("interrupt-note").textContent = "interrupted: the queue is cleared";
       break;
     case "planner_failed": onFailure(msg); break;
+    case "turn_cancelled": clearPlanning(); showCancelled(msg); scrollDown(); break;
+    case "cancel_refused": planning.refused(msg.message); break;
     case "reply_stopped":
       clearPlanning();
       if (msg.error) showError(`the reply stopped: ${msg.error}`);
@@ -128,10 +119,19 @@ function onMessage(msg) {
     case "library_saved": loadMotions(msg.name); break;
     case "state":
       robot.update(msg);
+      planning.update(msg.planning);
       if (msg.library_version !== libraryVersion) { libraryVersion = msg.library_version; loadMotions(); }
       break;
     case "error": showError(msg.message); clearPlanning(); break;
   }
+}
+
+// the cancelled line's own bubble (sent just now, or replayed) stays; the note says nothing came of it
+function showCancelled(msg) {
+  const last = history.lastElementChild;
+  if (!last?.matches(".bubble.user[data-utterance]")) history.append(userBubble(msg.utterance));
+  history.querySelectorAll(".bubble.user[data-utterance]").forEach((n) => n.removeAttribute("data-utterance"));
+  history.append(cancelledNote(msg));
 }
 
 function onFailure(msg) {
@@ -154,6 +154,8 @@ const socket = connect({
   frame: (tag, blob) => robot.frame(tag, blob),
   status: showConnection,
 });
+const planning = new PlanningBubble(history, (msg) => socket.send(msg));
+new ReportPanel($("report"));
 
 // Disconnected: said at the top of the conversation, on the view, and on every action that cannot go out.
 function showConnection(up) {
@@ -172,9 +174,16 @@ $("say-form").addEventListener("submit", (event) => {
   if (!text) return;
   if (!socket.send({ type: "say", text, attach_camera: $("attach").checked })) { notSent("your line was"); return; }
   $("say-text").value = "";
+  typing = false;  // the line is sent: the server plans it (the thinking posture)
   showCount();
 });
 $("say-text").addEventListener("input", showCount);
+// While the visitor types the robot takes its listening posture; emptying the line gives it up.
+let typing = false;
+$("say-text").addEventListener("input", () => {
+  const started = $("say-text").value.trim() !== "";
+  if (started !== typing && socket.send({ type: "listening", active: started })) typing = started;
+});
 $("gesture-go").addEventListener("click", () => {
   const sent = socket.send({ type: "gesture", name: $("gesture-name").value,
     intensity: Number($("gesture-intensity").value) });
@@ -227,5 +236,6 @@ async function sendRecording(blob) {
 }
 
 $("mic").addEventListener("pointerdown", startRecording);
+$("mic").addEventListener("pointerdown", () => socket.send({ type: "listening", active: true }));
 $("mic").addEventListener("pointerup", stopRecording);
 $("mic").addEventListener("pointercancel", stopRecording);
