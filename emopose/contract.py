@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from enum import StrEnum
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import (
@@ -16,6 +16,7 @@ from pydantic import (
     ConfigDict,
     Field,
     PrivateAttr,
+    StringConstraints,
     ValidationInfo,
     create_model,
     field_validator,
@@ -37,6 +38,7 @@ USABLE_SOURCES = frozenset({"model", "retried", "scripted"})
 
 MIN_KEYFRAMES, MAX_KEYFRAMES = 3, 14
 MAX_DURATION_S = 20.0  # the longest motion a library entry may state (its duration or last keyframe time)
+MAX_EXAMPLES = 8  # example utterances a motion file may carry
 # The longest text of a record (the parser cuts a trigger or variant to it at a word), and the piece a
 # tour line is planned in (whole sentences under it); a reply keeps more (stages/parse.py MAX_SPOKEN_CHARS).
 MAX_REPLY_CHARS = 200
@@ -128,6 +130,8 @@ def plan_schema(variants: Sequence[str], max_gestures: int) -> dict:
 
 
 MotionType = Literal["sequence", "pose"]
+ExampleUtterance = Annotated[str, StringConstraints(strip_whitespace=True, min_length=3,
+                                                    max_length=MAX_REPLY_CHARS)]
 
 
 class LibraryEntry(BaseModel):
@@ -148,6 +152,8 @@ class LibraryEntry(BaseModel):
     # When each keyframe is reached, s from the motion's start (times[0] = 0; the last is the duration).
     # Without it the keyframes are evenly spaced over the duration.
     times: tuple[float, ...] | None = None
+    # A few utterances the motion fits, read by the local planner next to the description (no retraining)
+    examples: tuple[ExampleUtterance, ...] = Field(default=(), max_length=MAX_EXAMPLES)
     _q: np.ndarray = PrivateAttr()
 
     @field_validator("keyframes")

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from emopose.bench.sequence_metrics import SequencePrediction, item_scores
 from emopose.bench.suites import SequenceItem
 from emopose.planners.local.data import Example, load_examples
-from emopose.planners.local.planner import LocalPlanner, ScoredUtterance, trigger_span
+from emopose.planners.local.planner import LocalPlanner, ScoredUtterance, act_trigger
 from emopose.resources import Run
 from emopose.results import JobOutput, markdown_table
 
@@ -64,8 +64,8 @@ def held_out_metrics(planner: LocalPlanner, examples: list[Example], scored: lis
             continue
         gold_anchors = tuple(example.text[a:b] for a, b in example.anchors)
         item = SequenceItem(example.id, example.text, gold, gold_anchors, tuple(example.variants))
-        triggers = tuple(example.text[slice(*trigger_span(example.text, scores.analysis, (a.start, a.end)))]
-                         for a in acts)
+        spans = [act_trigger(example.text, scores.analysis, (a.start, a.end), a.cls) for a in acts]
+        triggers = tuple(example.text[start:end] for start, end in spans)
         result = item_scores(item, SequencePrediction(classes, triggers,
                                                       tuple(a.variant for a in acts)))
         sequences += 1

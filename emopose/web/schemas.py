@@ -71,6 +71,7 @@ class SaveRequest(_Strict):
     stroke: tuple[int, int] | None = None
     times: list[float] | None = Field(default=None, max_length=14)
     keyframes: list[Keyframe] = Field(min_length=1, max_length=14)
+    examples: list[str] | None = None  # utterances the local planner reads next to the description
     overwrite: bool = Field(default=False, strict=True)
 
     def motion(self) -> dict:

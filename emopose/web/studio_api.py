@@ -8,6 +8,7 @@ reload makes the motion visible to the resolver and every planner's guide at onc
 from __future__ import annotations
 
 import base64
+from dataclasses import asdict
 
 import numpy as np
 from fastapi import APIRouter, HTTPException, Path, Request
@@ -15,6 +16,9 @@ from fastapi.responses import JSONResponse
 
 from emopose import CLASSES
 from emopose.contract import LibraryEntry
+from emopose.library import LibraryError
+from emopose.planners.local.planner import LocalPlanner
+from emopose.planners.local.probes import probe_moves
 from emopose.studio.authoring import DraftError, DraftReport
 from emopose.studio.saving import NAME_PATTERN, SaveRefused, delete_motion, rename_motion, save_motion
 from emopose.web.pose_renderer import RenderUnavailable
@@ -138,6 +142,21 @@ def save(body: SaveRequest, request: Request):
     except SaveRefused as exc:
         return JSONResponse({"error": str(exc)}, status_code=exc.status)
     return _saved(session, result)
+
+
+@router.post("/studio/probes")
+def probes(body: SaveRequest, request: Request) -> dict:
+    """Before saving: which of the library's probe utterances the motion would take, and from which motion
+    (the local planner reads descriptions and examples: planners/local/probes.py)."""
+    session = session_of(request)
+    try:
+        entry = session.res.library.validate(body.motion(), source="request")
+    except LibraryError as exc:
+        raise HTTPException(422, str(exc)) from exc
+    planner = session.res.planner
+    if not isinstance(planner, LocalPlanner):
+        raise HTTPException(409, f"the probes need planner=local; this server plans with {planner.name}")
+    return {"name": entry.name, "class": entry.cls, "taken": [asdict(m) for m in probe_moves(planner, entry)]}
 
 
 def _saved(session: LiveSession, result) -> dict:

@@ -13,13 +13,14 @@ from emopose.planners.local.variants import ClassMove, Features, VariantChooser,
 
 CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who knows"),
              "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}
+EVIDENCE = {name: (cls, (text,)) for name, (cls, text) in CATALOGUE.items()}  # what choose() reads
 AXIS = {name: k for k, name in enumerate(CATALOGUE)}  # each motion's description is one axis of a 4-D space
 NO_WORDS = (np.zeros(0, dtype=int), np.zeros(0, dtype=np.float32))
 STAY, MOVE = ClassMove(annotated=0.0, new=0.0), ClassMove(annotated=2.0, new=2.0)
 
 
 def describe(texts: list[str], words: dict[str, tuple] | None = None) -> Features:
-    names = [n for n, (_, t) in CATALOGUE.items() if t in texts]
+    names = [next(n for n, (_, t) in CATALOGUE.items() if t == text) for text in texts]  # in their order
     rows = np.eye(4, dtype=np.float32)[[AXIS[n] for n in names]]
     return Features(rows, rows, rows, [(words or {}).get(n, NO_WORDS) for n in names])
 
@@ -44,22 +45,22 @@ def chooser():
 
 def test_the_best_fitting_motion_of_the_class_is_chosen(chooser):
     unsure = proba(doubting=0.6, rejecting=0.4)
-    chosen = chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("shrug"), STAY)
+    chosen = chooser.choose(lambda: EVIDENCE, 1, "doubting", unsure, act_near("shrug"), STAY)
     assert chosen == ("doubting", "shrug")
     # without the class weight the class is the split model's, even when another class's motion fits
-    chosen = chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, act_near("finger_wag"), STAY)
+    chosen = chooser.choose(lambda: EVIDENCE, 1, "doubting", unsure, act_near("finger_wag"), STAY)
     assert chosen[0] == "doubting"
 
 
 def test_a_clearly_better_motion_may_move_an_unsure_act_but_not_a_sure_one(chooser):
     scolding = act_near("finger_wag")
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), scolding,
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), scolding,
                           MOVE) == ("rejecting", "finger_wag")
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.999), scolding,
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", proba(doubting=0.999), scolding,
                           MOVE) == ("doubting", "chin_stroke")
     # an act that fits a doubting motion as well as the rejecting one keeps the likelier class
     even = act_near("chin_stroke", "finger_wag", 0.5)
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
                           MOVE)[0] == "doubting"
 
 
@@ -68,27 +69,27 @@ def test_a_motion_the_training_data_never_annotated_moves_the_class_further():
     weights = Weights(word=1.0, shared=1.0, pretrained_share=0.0)
     chooser = VariantChooser(new_projections(4), describe, weights, frozenset(CATALOGUE) - {"finger_wag"})
     scolding, sure = act_near("finger_wag"), proba(doubting=0.999)
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding, MOVE)[0] == "doubting"
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", sure, scolding, MOVE)[0] == "doubting"
     # the class head was sure without knowing the new motion; its clear fit moves the act all the same
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding,
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", sure, scolding,
                           ClassMove(annotated=2.0, new=8.0)) == ("rejecting", "finger_wag")
     # the larger weight is the new motion's alone: an annotated one fitting as well moves no further
     known = VariantChooser(new_projections(4), describe, Weights(word=1.0, shared=1.0, pretrained_share=0.0),
                            frozenset(CATALOGUE))
-    assert known.choose(lambda: CATALOGUE, 1, "doubting", sure, scolding,
+    assert known.choose(lambda: EVIDENCE, 1, "doubting", sure, scolding,
                         ClassMove(annotated=2.0, new=8.0))[0] == "doubting"
     # however large its weight, a new motion that fits no better than the act's own class's never moves it
     even = act_near("chin_stroke", "finger_wag", 0.5)
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", proba(doubting=0.6, rejecting=0.4), even,
                           ClassMove(annotated=2.0, new=8.0))[0] == "doubting"
 
 
 def test_no_weight_no_move_even_toward_a_likelier_class(chooser):
     # the split may give an act a less likely class (neighbouring acts must differ); a weight of 0 keeps it
     likelier_elsewhere = proba(doubting=0.4, rejecting=0.6)
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", likelier_elsewhere, act_near("finger_wag"),
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", likelier_elsewhere, act_near("finger_wag"),
                           STAY) == ("doubting", "chin_stroke")
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", likelier_elsewhere, act_near("finger_wag"),
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", likelier_elsewhere, act_near("finger_wag"),
                           ClassMove(annotated=0.0, new=8.0))[0] == "doubting"  # finger_wag is annotated here
 
 
@@ -96,10 +97,10 @@ def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser
     scolding = act_near("finger_wag")
     unsure = proba(doubting=0.6, rejecting=0.4)
     # the split model's class has no motion in the library: it stays, without a motion
-    chosen = chooser.choose(lambda: CATALOGUE, 1, "neutral", proba(neutral=0.99), scolding, MOVE)
+    chosen = chooser.choose(lambda: EVIDENCE, 1, "neutral", proba(neutral=0.99), scolding, MOVE)
     assert chosen == ("neutral", None)
     # the act next to it is already rejecting: neighbouring acts keep differing in class
-    assert chooser.choose(lambda: CATALOGUE, 1, "doubting", unsure, scolding, MOVE,
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", unsure, scolding, MOVE,
                           frozenset({"rejecting"}))[0] == "doubting"
 
 
@@ -111,12 +112,12 @@ def test_a_rare_word_the_description_also_says_decides_between_motions():
                              Weights(word=0.0, shared=1.0, pretrained_share=0.0), frozenset(CATALOGUE))
     # the vectors lean to palm_stop; the shared rare word outweighs them
     naughty = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 7]), np.array([0.01, 0.9])))
-    chosen = chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), naughty, STAY)
+    chosen = chooser.choose(lambda: EVIDENCE, 1, "rejecting", proba(rejecting=1.0), naughty, STAY)
     assert chosen[1] == "finger_wag"
     # sharing only a frequent word carries no weight against the vectors; a token no description has (an
     # id past every description's) counts against the share
     plain = act_near("palm_stop", "finger_wag", 0.4, (np.array([1, 5, 30000]), np.array([0.01, 0.9, 0.9])))
-    chosen = chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), plain, STAY)
+    chosen = chooser.choose(lambda: EVIDENCE, 1, "rejecting", proba(rejecting=1.0), plain, STAY)
     assert chosen[1] == "palm_stop"
 
 
@@ -134,7 +135,7 @@ def test_a_share_of_the_pretrained_similarity_keeps_a_motion_the_projections_los
     def chosen(share: float) -> str | None:
         chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=share),
                                  frozenset(CATALOGUE))
-        return chooser.choose(lambda: CATALOGUE, 1, "rejecting", proba(rejecting=1.0), scolding, STAY)[1]
+        return chooser.choose(lambda: EVIDENCE, 1, "rejecting", proba(rejecting=1.0), scolding, STAY)[1]
 
     assert chosen(0.0) == "palm_stop"
     assert chosen(0.75) == "finger_wag"  # the pretrained cosines still see which description it is near
@@ -145,12 +146,20 @@ def test_an_empty_library_leaves_the_class_without_a_motion(chooser):
     assert chosen == ("doubting", None)
 
 
+def test_a_motion_scores_as_its_best_fitting_text_its_examples_included(chooser):
+    act = act_near("palm_stop")  # a "stop" act of the doubting class: shrug or chin_stroke
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", proba(doubting=1.0), act, STAY)[1] != "shrug"
+    with_example = EVIDENCE | {"shrug": ("doubting", ("who knows", "stop"))}  # an example reads like "stop"
+    chosen = chooser.choose(lambda: with_example, 2, "doubting", proba(doubting=1.0), act, STAY)
+    assert chosen == ("doubting", "shrug")
+
+
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
     calls = []
 
     def catalogue():
         calls.append(1)
-        return CATALOGUE
+        return EVIDENCE
 
     for version in (1, 1, 2):
         chooser.choose(catalogue, version, "doubting", proba(doubting=1.0), act_near("shrug"), STAY)
@@ -173,7 +182,7 @@ def test_projections_learn_the_annotated_motion():
         chooser = VariantChooser(projections, describe, Weights(word=0.0, shared=0.0, pretrained_share=0.0),
                                  frozenset(CATALOGUE))
         act = Features(vector[None], vector[None], vector[None], [NO_WORDS])
-        return chooser.choose(lambda: CATALOGUE, 1, "doubting", proba(doubting=1.0), act, STAY)[1]
+        return chooser.choose(lambda: EVIDENCE, 1, "doubting", proba(doubting=1.0), act, STAY)[1]
 
     assert chosen() == "chin_stroke"
     acts = [AnnotatedAct("doubting", "shrug", between.clone(), between.clone()) for _ in range(64)]

@@ -216,3 +216,25 @@ def test_a_refusal_names_a_time_and_keyframes_not_a_sample(client):
     assert reasons, "this draft should collide"
     cited = re.compile(r"at \d+\.\d\d s \((at|between) K\d")
     assert all("sample" not in r and cited.search(r) for r in reasons), reasons
+
+
+def test_studio_probes_check_the_motion_then_need_the_local_planner(client):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    raised = list(rest)
+    raised[7] = -0.9
+    body = {"name": "little_salute", "class": "welcoming", "description": "a small salute; a greeting",
+            "keyframes": [rest, raised, rest]}
+    bad = client.post("/api/studio/probes", json=body | {"examples": ["ok"]})
+    assert bad.status_code == 422 and "examples.0: String should have at least 3 characters" in bad.text
+    refused = client.post("/api/studio/probes", json=body | {"examples": ["Ahoy there, sailor!"]})
+    assert refused.status_code == 409 and "planner=local" in refused.text  # the web tests plan with keyword
+
+
+def test_a_motion_saved_in_the_studio_keeps_its_examples(client, library_copy):
+    rest = client.get("/api/library").json()["neutral_pose"]
+    raised = list(rest)
+    raised[7] = -0.9
+    body = {"name": "little_salute", "class": "welcoming", "description": "a small salute; a greeting",
+            "keyframes": [rest, raised, rest], "examples": ["Ahoy there, sailor!"]}
+    assert client.post("/api/library", json=body).status_code == 201
+    assert client.get("/api/library/little_salute").json()["examples"] == ["Ahoy there, sailor!"]

@@ -13,8 +13,8 @@
    selectable without retraining), and for a pointing act the direction its words name
    (planners/local/direction.py); intensity from cues (intensifiers and exclamations up, hedges down);
    trigger = the words the gesture belongs to (the contract's rule: its lexical affiliate, starting at the
-   word the stroke lands on): those the anchor head marks around its strongest token; reply = the input text
-   (it always narrates: it has no mode to configure).
+   word the stroke lands on): those the anchor head marks around its strongest token, their left edge
+   moved onto the affiliate (planners/local/affiliate.py); reply = the input text (it always narrates).
 
 The model is trained by `+experiment=train_local`, or before first use when planner.train_if_missing
 (LocalPlanner.from_config; progress bars on stderr), seeded and cached under cache_dir
@@ -35,12 +35,14 @@ from emopose import CLASSES
 from emopose.library import MotionLibrary
 from emopose.planners.base import PlannerOutput, PlanRequest, timed
 from emopose.planners.local import semi_crf
+from emopose.planners.local.affiliate import affiliate_span
 from emopose.planners.local.artifact import (
     cached_artifact,
     load_model,
     train_artifact,
     train_missing_artifact,
 )
+from emopose.planners.local.catalogue import motion_catalogue, motion_evidence
 from emopose.planners.local.config import LocalSettings
 from emopose.planners.local.direction import pointing_motion
 from emopose.planners.local.heads import Analysis
@@ -85,6 +87,11 @@ def trigger_span(text: str, analysis: Analysis, act: tuple[int, int], max_words:
     lo_word = max(min(marked, default=centre), centre - max_words + 1)
     hi_word = min(max(marked, default=centre), lo_word + max_words - 1)
     return words[lo_word].start(), words[hi_word].end()
+
+
+def act_trigger(text: str, analysis: Analysis, act: tuple[int, int], cls: str) -> tuple[int, int]:
+    """A `cls` act's trigger span: the anchor head's phrase, its left edge on the affiliate."""
+    return affiliate_span(text, trigger_span(text, analysis, act), cls)
 
 
 @dataclass
@@ -210,7 +217,7 @@ class LocalPlanner:
             proba = softmax(scored.logits[k])
             neighbours = {acts[-1].cls} if acts else set()  # neighbouring acts keep differing in class
             neighbours |= {CLASSES[split[n + 1][1]]} if n + 1 < len(split) else set()
-            cls, variant = self.variants.choose(self._catalogue, self.library.version, CLASSES[c], proba,
+            cls, variant = self.variants.choose(self._evidence, self.library.version, CLASSES[c], proba,
                                                 scored.features[k], self.class_move,
                                                 frozenset(neighbours))
             acts.append(_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, cls, proba, variant))
@@ -218,7 +225,7 @@ class LocalPlanner:
 
     def _record(self, act: _Act, analysis: Analysis, utterance: str) -> dict:
         text = utterance[act.start:act.end]
-        start, end = trigger_span(utterance, analysis, (act.start, act.end))
+        start, end = act_trigger(utterance, analysis, (act.start, act.end), act.cls)
         trigger, variant = utterance[start:end], act.variant
         directional = self.settings.pointing_directions.values()
         # a direction the words name decides among the directional motions (planners/local/direction.py);
@@ -233,8 +240,5 @@ class LocalPlanner:
     def _catalogue(self) -> dict[str, tuple[str, str]]:
         return motion_catalogue(self.library)
 
-
-def motion_catalogue(library: MotionLibrary) -> dict[str, tuple[str, str]]:
-    """Selectable motions of the live library: name -> (class, text its description is matched by)."""
-    return {e.name: (e.cls, f"{e.name.replace('_', ' ')}: {e.description}")
-            for e in library.snapshot.entries.values() if e.motion_type == "sequence"}
+    def _evidence(self) -> dict[str, tuple[str, tuple[str, ...]]]:
+        return motion_evidence(self.library)

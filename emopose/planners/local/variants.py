@@ -28,6 +28,9 @@ do; leaning on the shared words, known motions lose fewer acts to new ones). The
 frozen states, so they are trained apart from the encoder, in seconds, after its epochs
 (planners/local/variant_training.py).
 
+A motion file's `examples:` (utterances it fits) are read like its description, and a motion scores as
+its best-fitting text: evidence for a new motion's uses without retraining (planners/local/catalogue.py).
+
 The class is chosen with the motion (VariantChooser.choose): a motion of another class that fits the act
 better than its own class's best can move it, by log p(class) + w * (the score margin); w is larger for a
 motion the training data never annotated, whose uses the class head cannot know.
@@ -164,7 +167,7 @@ class VariantChooser:
         self.annotated = annotated
         self._cached: tuple = (-1, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool), ())
 
-    def choose(self, catalogue: Callable[[], dict[str, tuple[str, str]]], version: int, cls: str,
+    def choose(self, catalogue: Callable[[], dict[str, tuple[str, tuple[str, ...]]]], version: int, cls: str,
                proba: np.ndarray, act: Features, move: ClassMove,
                excluded: frozenset[str] = frozenset()) -> tuple[str, str | None]:
         """(class, motion) for an act the split model reads as cls with class probabilities proba.
@@ -175,26 +178,30 @@ class VariantChooser:
         while for a new one (a "finger wag" added by file, for a scolding the model read as comforting)
         the fit is all there is. A weight of 0 never moves; nor does anything when cls has no motion.
         Classes in excluded (the neighbouring acts') are never moved to. catalogue() -> the live
-        library's selectable motions, name -> (class, description text), read again when the library's
-        version changes. act: the act's Features (one row)."""
+        library's selectable motions, name -> (class, (description text, *example utterances)), read
+        again when the library's version changes; a motion scores as its best-fitting text. act: the
+        act's Features (one row)."""
         import torch
 
         cached = self._cached  # one read: another thread may replace it
         if cached[0] != version:
             entries = catalogue()
+            texts = [text for _, evidence in entries.values() for text in evidence]
             with torch.inference_mode():
-                described = projected(self.projections, self.describe([text for _, text in entries.values()]))
+                described = projected(self.projections, self.describe(texts))
                 motions = described._replace(words=word_presence(described.words))
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
             is_annotated = np.array([name in self.annotated for name in entries], dtype=bool)
-            cached = self._cached = (version, list(entries), classes, is_annotated, motions)
-        _, names, classes, is_annotated, motions = cached
+            owner = np.repeat(np.arange(len(entries)), [len(evidence) for _, evidence in entries.values()])
+            cached = self._cached = (version, list(entries), classes, is_annotated, (motions, owner))
+        _, names, classes, is_annotated, (motions, owner) = cached
         own = CLASSES.index(cls)
         members = np.flatnonzero(classes == own)
         if not len(members):
             return cls, None
-        with torch.inference_mode():
-            row = scores(projected(self.projections, act), motions, self.weights)[0]
+        row = np.full(len(names), -np.inf)
+        with torch.inference_mode():  # a motion's score: its best-fitting text (description or example)
+            np.maximum.at(row, owner, scores(projected(self.projections, act), motions, self.weights)[0])
         own_best = members[int(np.argmax(row[members]))]
         chosen, best_total = own_best, np.log(proba[own] + 1e-12)
         weight = np.where(is_annotated, move.annotated, move.new)

@@ -1,0 +1,69 @@
+"""The lexical affiliate inside a trigger: where the words the gesture belongs to start (issue 29).
+
+The anchor head marks the phrase that carries an act, and it learned that phrase from training anchors
+many of which are whole clauses ("the kennel is over to your left"), where the suites and the contract
+(contract.TRIGGER_RULE) mark the affiliate itself ("over to your left"): the place pointed at, a
+statement's new information, the hedge, the yes, no or greeting. A trigger's left edge is therefore
+trimmed by three documented rules of English clause structure, never by words of any suite:
+
+- a leading joiner or attention-getter ("and", "but", "so", "look,", "remember,") belongs to no
+  affiliate;
+- pointing: the subject and its verb before the place ("the kennel is | over to your left", "your
+  coat's | on the hook"): a pointing gesture's affiliate is the locative or deictic phrase;
+- neutral and emphasizing: a short subject before a copula and the predicate it introduces ("The retake
+  is | on the 9th"), or before a verb ending in -s/-ed ("The exhibition | closes at six"): the new
+  information carries the stress (the nuclear accent falls late in the English clause); but an
+  emphasizing subject that is itself the emphasis (a superlative or an evaluative adjective: "the
+  crucial thing is", "the biggest danger is") keeps it.
+
+A trim that would leave fewer than two words keeps the trigger whole, and so does one whose shorter text
+occurs earlier in the reply (the schedule finds a trigger at its first occurrence, contract.py).
+"""
+
+from __future__ import annotations
+
+import re
+
+from emopose.contract import trigger_position
+
+_JOINER = re.compile(r"^(?:(?:and|but|so|then|or|plus)\s+|(?:look|listen|remember|well|now|see)\s*,\s*)",
+                     re.IGNORECASE)
+_PLACE = (r"(?:just\s+|right\s+|straight\s+|all\s+the\s+way\s+)?"
+          r"(?:over|up|down|across|behind|beside|next|near|under|underneath|above|below|past|through|along|"
+          r"around|inside|outside|upstairs|downstairs|on|in|at|by|opposite|round|beyond|off|out|back|here|"
+          r"there)\b")
+_SUBJECT_VERB = (r"^(?:[\w'-]+\s+){0,4}?(?:is|are|was|were|sits?|stands?|lies|lie|hangs?|waits?|starts?|"
+                 r"begins?|leaves|departs?|goes|go|runs?|meets?|stops?|kept|stored|parked|located|hidden)\s+")
+_POINTING = re.compile(rf"{_SUBJECT_VERB}(?={_PLACE})|^(?:[\w'-]+\s+){{0,3}}?[\w-]+'(?:s|re)\s+(?={_PLACE})",
+                       re.IGNORECASE)
+_STATEMENT = re.compile(r"^(?:the|a|an|your|our|my|his|her|their|its|this|that|these|those|it|we|they|he|"
+                        r"she)"
+                        r"(?:\s+[\w'-]+){0,3}?\s+(?:is|are|was|were|will\s+be|has\s+been|have\s+been)\s+"
+                        r"|^(?:it|that|there|we|they|he|she|you)'(?:s|re|ll\s+be)\s+"
+                        r"|^(?:the|your|our|my|this|that|these|those|his|her|their|its)(?:\s+[\w'-]+){1,3}?\s+"
+                        r"(?=[a-z]+(?:s|ed)\s)", re.IGNORECASE)
+_EMPHATIC_SUBJECT = re.compile(r"\b(?:most|least|\w{2,}est|crucial|important|key|main|vital|essential|only|"
+                               r"golden|critical|first|last|one)\b", re.IGNORECASE)
+_RULES = {"pointing": _POINTING, "neutral": _STATEMENT, "emphasizing": _STATEMENT}
+_WORD = re.compile(r"[\w'-]+")
+
+
+def affiliate(phrase: str, cls: str) -> str:
+    """The phrase without what precedes its affiliate (the module docstring's rules): a suffix of it."""
+    trimmed = _JOINER.sub("", phrase, count=1)
+    rule = _RULES.get(cls)
+    if rule is not None and (match := rule.match(trimmed)):
+        rest = trimmed[match.end():]
+        emphatic = cls == "emphasizing" and _EMPHATIC_SUBJECT.search(trimmed[:match.end()])
+        if len(_WORD.findall(rest)) >= 2 and not emphatic:
+            trimmed = rest
+    return trimmed if _WORD.search(trimmed) else phrase
+
+
+def affiliate_span(text: str, span: tuple[int, int], cls: str) -> tuple[int, int]:
+    """The trigger span text[span] of a `cls` act, its start moved onto the affiliate where the trimmed
+    trigger is still found there first."""
+    start, end = span
+    trimmed = affiliate(text[start:end], cls)
+    moved = end - len(trimmed)
+    return (moved, end) if trigger_position(text, trimmed) == moved else span
