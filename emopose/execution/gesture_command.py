@@ -30,6 +30,7 @@ class GestureCommand:
     record: int | None = None               # index of the plan record it performs, when it comes from a turn
     stroke: tuple[int, int] | None = None   # keyframe indices of the stroke, for the "stroke" event
     offsets: tuple[float, ...] | None = None
+    authored_times: tuple[float, ...] | None = None  # untimed: the motion's own keyframe times (`times:`)
     blend_in: bool = False                  # timed: the first segment is a co-articulation blend
     cut: bool = False                       # timed: planned to end after its stroke (reported as CUT)
 

@@ -185,7 +185,7 @@ class Sequencer(CommandQueue):
             times = np.asarray(command.offsets[1:]) + (command.release_at - now)
             motion = self.builder.build_timed(keyframes, times, self.last, command.blend_in)
         else:
-            motion = self.builder.build(keyframes, command.duration, self.last)
+            motion = self.builder.build(keyframes, command.duration, self.last, command.authored_times)
         self.construction_s.append(time.perf_counter() - started)
         reason = self.safety(motion.samples) if self.safety else None
         if reason is not None:

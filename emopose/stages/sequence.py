@@ -70,8 +70,11 @@ class SequenceStage:
                       record=k)
         timing = release.timing
         if timing is None:
-            return GestureCommand(keyframes=gesture.keyframes, stroke=gesture.resolved.entry.stroke_span,
-                                  **common)
+            entry = gesture.resolved.entry
+            authored = None if entry.times is None else tuple(
+                t * gesture.duration / entry.times[-1] for t in entry.times)
+            return GestureCommand(keyframes=gesture.keyframes, stroke=entry.stroke_span,
+                                  authored_times=authored, **common)
         offsets = tuple(t - timing.times[0] for t in timing.times)
         return GestureCommand(keyframes=timing.keyframes, stroke=timing.stroke, offsets=offsets,
                               blend_in=timing.blend_in, cut=timing.cut, **common)

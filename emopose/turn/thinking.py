@@ -69,7 +69,8 @@ class ThinkingGesture:
             return set()
         now = self.clock.now()
         commands = [GestureCommand(name=entry.name, keyframes=entry.q, duration=entry.default_duration,
-                                   release_at=now, label=THINKING_LABEL) for _ in range(self.repeats)]
+                                   release_at=now, label=THINKING_LABEL, authored_times=entry.times)
+                    for _ in range(self.repeats)]
         for command in commands:
             sequencer.submit(command)
         return {c.id for c in commands}

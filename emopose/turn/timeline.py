@@ -9,22 +9,19 @@ backwards from there. Gestures are placed in the order of their words, each agai
 2. co-articulated: the previous gesture is cut at its stroke end and its last stroke pose blends
    (the paper's cubic blend) straight into this gesture's preparation, time-scaled within `scale`
    (slower first, holding the previous stroke pose for any time left), never beyond the speed bound;
-3. shortened: as 2, cutting the previous stroke at an earlier keyframe (down to its stroke start);
-   a blend the robot's safety check would refuse (the arms would collide) is not used;
-4. retracted fast: the previous gesture returns to rest at up to `scale[0]` and this one prepares
-   from rest, time-scaled down to `scale[0]`;
+3. shortened: as 2, cutting the previous stroke at an earlier keyframe (down to its stroke start); a
+   blend the robot's safety check would refuse (the arms would collide) is not used;
+4. retracted fast: the previous gesture retracts at up to `scale[0]`, this one prepares from rest;
 5. via a pose, only where 2-3 fit in time but every blend was unsafe: the previous stroke (cut as in 3)
    blends to a via pose, halfway to rest ("via_halfway") or rest itself ("via_rest"), and on into this
    preparation, the whole path passing the same safety check;
 6. dropped, with the reason, when none of these fits.
 The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
-preparation needs more, it is compressed (down to `first_scale`, below `scale[0]` since only
-the speed bound limits it), then shortened to one segment straight
-to the stroke start ("direct", for strokes after several preparation keyframes), and then lands late.
+preparation needs more, it is compressed (down to `first_scale`: only the speed bound limits it), then
+goes straight to the stroke start ("direct", after several preparation keyframes), then lands late.
 Its first segment starts from wherever the arm is at its start time; when the arm is away from rest at
-planning time (a reply interrupting motion, or the thinking gesture, which then blend back to rest), that
-segment is made long enough from the arm's pose too, so the sequencer never has to slow it down.
-`lag_s` moves everything earlier to absorb the actuators' tracking lag (0 for a command stream).
+planning time (interrupted motion, the thinking gesture), that segment is long enough from there too.
+`lag_s` moves everything earlier for the actuators' tracking lag. Segments keep a motion's `times:`.
 """
 
 from __future__ import annotations
@@ -69,7 +66,7 @@ class _Placed:
     name: str
     anchors: np.ndarray
     stroke: tuple[int, int]
-    step: float  # nominal segment length (s)
+    steps: np.ndarray  # nominal length (s) of each segment, anchors[i] -> anchors[i + 1]
     times: list[float]
     target: float
     arrival: float
@@ -114,7 +111,7 @@ class TimelinePlanner:
     # -- placing one gesture -------------------------------------------------------------------------
     def _place(self, gesture: ModulatedGesture, aim: float, prev: _Placed | None,
                arm: np.ndarray | None) -> _Placed | str:
-        anchors, stroke, step = self._shape(gesture)
+        anchors, stroke, steps = self._shape(gesture)
         low, high = self.settings.scale
         name = gesture.name
         if prev is None:
@@ -122,17 +119,17 @@ class TimelinePlanner:
             # blend from `arm` back to rest stays between the two, so both bounds cover it
             origins = anchors[:1] if arm is None else np.vstack([anchors[0], arm])
             earliest = -self.settings.max_preroll_s
-            placed = self._prepare(name, anchors, stroke, step, origins, False, earliest, aim,
+            placed = self._prepare(name, anchors, stroke, steps, origins, False, earliest, aim,
                                    (1.0, self.settings.first_scale))
-            return placed or self._late(name, anchors, stroke, step, origins, earliest, aim)
-        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, prev.times[-1], aim,
+            return placed or self._late(name, anchors, stroke, steps, origins, earliest, aim)
+        placed = self._prepare(name, anchors, stroke, steps, anchors[0], False, prev.times[-1], aim,
                                (1.0, 1.0))
         if placed is not None:
             return placed
         unsafe = ""
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
-            placed = self._prepare(name, anchors, stroke, step, prev.anchors[cut], True, prev.times[cut], aim,
-                                   (high, low))
+            placed = self._prepare(name, anchors, stroke, steps, prev.anchors[cut], True, prev.times[cut],
+                                   aim, (high, low))
             if placed is None:
                 continue  # cutting earlier in the stroke leaves more time
             unsafe = self._unsafe(placed, prev.anchors[cut])
@@ -141,12 +138,12 @@ class TimelinePlanner:
                 placed.fit = "coarticulated" if cut == prev.stroke[1] else "shortened"
                 return placed
         retraction = self._retract(prev, low)
-        placed = self._prepare(name, anchors, stroke, step, anchors[0], False, retraction[-1], aim,
+        placed = self._prepare(name, anchors, stroke, steps, anchors[0], False, retraction[-1], aim,
                                (1.0, low))
         if placed is not None:
             prev.times[prev.stroke[1]:] = retraction
             return placed
-        via = self._via(name, anchors, stroke, step, prev, aim) if unsafe else None
+        via = self._via(name, anchors, stroke, steps, prev, aim) if unsafe else None
         if via is not None:
             return via
         room = aim - prev.times[prev.stroke[0]]
@@ -154,14 +151,15 @@ class TimelinePlanner:
             f"too little to prepare at {low:g}x and the joint speed bound")
         return f"no room: its stroke is {room * 1e3:.0f} ms after {prev.name}'s stroke start; {why}"
 
-    def _via(self, name, anchors, stroke, step, prev: _Placed, aim: float) -> _Placed | None:
+    def _via(self, name, anchors, stroke, steps, prev: _Placed, aim: float) -> _Placed | None:
         """Rule 5: the first safe path from prev's stroke (latest cut first) through a via pose."""
         low, high = self.settings.scale
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
             start_pose = prev.anchors[cut]
             for via, fit in (((start_pose + anchors[0]) / 2, "via_halfway"), (anchors[0], "via_rest")):
-                shape = np.vstack([anchors[:1], via, anchors[1:]])
-                placed = self._prepare(name, shape, (stroke[0] + 1, stroke[1] + 1), step, start_pose, True,
+                shape = np.vstack([anchors[:1], via, anchors[1:]])  # the via segment as long as the first
+                placed = self._prepare(name, shape, (stroke[0] + 1, stroke[1] + 1), np.r_[steps[:1], steps],
+                                       start_pose, True,
                                        prev.times[cut], aim, (high, low), lead=2)
                 if placed is not None and not self._unsafe(placed, start_pose):
                     prev.cut, placed.fit = cut, fit
@@ -181,61 +179,65 @@ class TimelinePlanner:
         """prev's keyframe times from its stroke end on, with the retraction time-scaled."""
         end = prev.stroke[1]
         durations = self._durations(prev.anchors, prev.anchors[0], end, len(prev.anchors) - 1,
-                                    prev.step * scale, False)
+                                    prev.steps * scale, False)
         return np.cumsum([prev.times[end], *durations]).tolist()
 
     @staticmethod
-    def _shape(gesture: ModulatedGesture) -> tuple[np.ndarray, tuple[int, int], float]:
-        """Anchors (a pose becomes start -> pose), stroke indices and the nominal segment length."""
-        q = np.asarray(gesture.keyframes, dtype=float)
+    def _shape(gesture: ModulatedGesture) -> tuple[np.ndarray, tuple[int, int], np.ndarray]:
+        """Anchors (a pose becomes start -> pose), stroke indices and the nominal segment lengths: the
+        entry's own keyframe times where it gives them (`times:`, scaled to the duration), else even."""
+        q, entry, d = np.asarray(gesture.keyframes, dtype=float), gesture.resolved.entry, gesture.duration
         if len(q) == 1:
-            return np.vstack([q, q]), (1, 1), gesture.duration
-        return q, gesture.resolved.entry.stroke_span, gesture.duration / (len(q) - 1)
+            return np.vstack([q, q]), (1, 1), np.array([d])
+        steps = np.full(len(q) - 1, d / (len(q) - 1)) if entry.times is None else np.diff(entry.times) * (
+            d / entry.times[-1])
+        return q, entry.stroke_span, steps
 
-    def _prepare(self, name, anchors, stroke, step, start_pose, blend_in, earliest, aim,
+    def _prepare(self, name, anchors, stroke, steps, start_pose, blend_in, earliest, aim,
                  scales, lead: int = 1) -> _Placed | None:
         """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
         to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
         start from the first `lead` anchors; None if even that would need to start before `earliest`."""
-        shapes = [(anchors, stroke, None)]
-        if stroke[0] > lead:  # skip the intermediate preparation keyframes
+        shapes = [(anchors, stroke, steps, None)]
+        if stroke[0] > lead:  # skip the intermediate preparation keyframes (and their segments' time)
             shapes.append((np.vstack([anchors[:lead], anchors[stroke[0]:]]),
-                           (lead, stroke[1] - stroke[0] + lead), "direct"))
+                           (lead, stroke[1] - stroke[0] + lead),
+                           np.r_[steps[:lead - 1], steps[stroke[0] - 1:]], "direct"))
         grid = np.arange(scales[0], scales[1] - 1e-9, -0.05).tolist() + [scales[1]]
-        for shape, sync, how in shapes:
+        for shape, sync, shape_steps, how in shapes:
             for scale in np.unique(np.clip(grid, scales[1], scales[0]))[::-1]:
-                durations = self._durations(shape, start_pose, 0, sync[0], step * scale, blend_in)
+                durations = self._durations(shape, start_pose, 0, sync[0], shape_steps * scale, blend_in)
                 arrival_lead = self._approach(start_pose if sync[0] == 1 else shape[sync[0] - 1],
                                               shape[sync[0]], durations[-1], blend_in and sync[0] == 1)
                 start = aim + arrival_lead - sum(durations)
                 if start >= earliest - 1e-9:
                     fit: Fit = how or ("nominal" if scale == 1.0 else "scaled")
-                    return self._finish(name, shape, sync, step, start_pose, start, durations, aim, aim, fit,
-                                        blend_in, float(scale))
+                    return self._finish(name, shape, sync, shape_steps, start_pose, start, durations, aim,
+                                        aim, fit, blend_in, float(scale))
         return None
 
-    def _late(self, name, anchors, stroke, step, origins, start, aim) -> _Placed:
+    def _late(self, name, anchors, stroke, steps, origins, start, aim) -> _Placed:
         """The first gesture when even the pre-roll and the fastest preparation cannot meet its word."""
         low = self.settings.first_scale
-        durations = self._durations(anchors, origins, 0, stroke[0], step * low, False)
+        durations = self._durations(anchors, origins, 0, stroke[0], steps * low, False)
         before = origins if stroke[0] == 1 else anchors[stroke[0] - 1]
         arrival = start + sum(durations) - self._approach(before, anchors[stroke[0]], durations[-1], False)
-        return self._finish(name, anchors, stroke, step, origins, start, durations, aim, arrival, "late",
+        return self._finish(name, anchors, stroke, steps, origins, start, durations, aim, arrival, "late",
                             False, low)
 
-    def _finish(self, name, anchors, stroke, step, start_pose, start, prep, aim, arrival, fit, blend_in,
+    def _finish(self, name, anchors, stroke, steps, start_pose, start, prep, aim, arrival, fit, blend_in,
                 scale) -> _Placed:
-        rest = self._durations(anchors, start_pose, stroke[0], len(anchors) - 1, step, False)
+        rest = self._durations(anchors, start_pose, stroke[0], len(anchors) - 1, steps, False)
         times = np.cumsum([start, *prep, *rest]).tolist()
-        return _Placed(name, anchors, stroke, step, times, aim, arrival, fit, blend_in, scale)
+        return _Placed(name, anchors, stroke, steps, times, aim, arrival, fit, blend_in, scale)
 
-    def _durations(self, anchors, start_pose, first, last, length, blend_in) -> list[float]:
-        """Segment durations from keyframe `first` to `last`, each at least its speed-bound minimum."""
+    def _durations(self, anchors, start_pose, first, last, lengths, blend_in) -> list[float]:
+        """Each segment from keyframe `first` to `last`: lengths[i - 1] into keyframe i, or its minimum."""
         out = []
         for i in range(first + 1, last + 1):
             origin = start_pose if i == 1 else anchors[i - 1]
-            out.append(max(length, self.builder.segment_minimum(origin, anchors[i], blend_in and i == 1),
-                           self.builder.dt))
+            shortest = self.builder.segment_minimum(origin, anchors[i], blend_in and i == 1)
+            out.append(max(float(lengths[i - 1]), shortest, self.builder.dt))
         return out
 
     def _approach(self, q_from: np.ndarray, q_to: np.ndarray, duration: float, blend: bool) -> float:

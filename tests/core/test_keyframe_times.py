@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -14,8 +15,12 @@ import pytest
 from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.joint_limits import LibraryError
 from emopose.stages.modulate import Modulate
+from emopose.stages.sequence import SequenceStage
 from emopose.studio.authoring import PoseStudio
+from emopose.turn.model import Release
+from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 from tests.conftest import REST, load_library, make_library_dir, write_motion
+from tests.core.conftest import gesture
 
 GOLDEN = Path(__file__).with_name("shipped_trajectories.json")
 UP = [*REST[:7], -0.9, -0.5, *REST[9:]]  # the right arm raised forward-out
@@ -108,3 +113,26 @@ def test_shipped_motions_build_exactly_as_before(g1):
         report = studio.report(entry, 5)
         plain = studio.builder.build(report.keyframes, entry.default_duration, rest)
         assert np.array_equal(report.trajectory.samples, plain.samples)
+
+
+def test_a_replys_timeline_keeps_the_motions_own_keyframe_times(tmp_path):
+    folder = make_library_dir(tmp_path / "lib")
+    write_motion(folder, "timed_raise", "agreeing", [REST, UP, UP, REST], times=[0.0, 0.4, 1.6, 2.0],
+                 stroke=[1, 2])
+    write_motion(folder, "even_raise", "agreeing", [REST, UP, UP, REST], duration=2.0, stroke=[1, 2])
+    library = load_library(folder)
+    planner = TimelinePlanner(TrajectoryBuilder(library.limits), TimelineSettings())
+    (timed, even), _ = planner.plan([gesture(library, "timed_raise"), gesture(library, "even_raise")],
+                                    [2.0, 8.0])
+    assert timed.fit == even.fit == "nominal"
+    assert np.allclose(np.diff(timed.times), [0.4, 1.2, 0.4])  # as written, not an even 2/3 s each
+    assert np.allclose(np.diff(even.times), 2.0 / 3.0)
+
+
+def test_an_untimed_command_builds_with_the_motions_own_times(tmp_path):
+    folder = make_library_dir(tmp_path / "lib")
+    write_motion(folder, "timed_raise", "agreeing", [REST, UP, UP, REST], times=[0.0, 0.4, 1.6, 2.0])
+    modulated = gesture(load_library(folder), "timed_raise")
+    slower = replace(modulated, duration=4.0)  # a schedule that stretches the motion keeps its rhythm
+    command = SequenceStage._command(0, slower, Release(0.0, "words", True), 0.0)
+    assert not command.timed and command.authored_times == pytest.approx((0.0, 0.8, 3.2, 4.0))

@@ -107,6 +107,7 @@ class VoiceSender:
         with self._changed:
             dropped = sum(1 for c in self._chunks if c.stream_id == job.stream_id)
             self._chunks = deque(c for c in self._chunks if c.stream_id != job.stream_id)
-        log.warning("player=g1: an audio chunk of stream %s failed (%s: %s); its %d later chunk(s) are "
-                    "not sent, the arms keep their timing", job.stream_id, type(exc).__name__, exc, dropped)
+        # the detail only: on_failure gives the one warning (the player's fallback)
+        log.info("player=g1: an audio chunk of stream %s failed (%s: %s); its %d later chunk(s) are "
+                 "not sent, the arms keep their timing", job.stream_id, type(exc).__name__, exc, dropped)
         self.on_failure(exc)

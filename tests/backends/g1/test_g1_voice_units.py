@@ -3,6 +3,7 @@ ordering of stops and chunks, the chest light's coalescing, and player=g1's conf
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 import wave
@@ -93,6 +94,7 @@ def test_a_stop_reaches_the_robot_before_the_next_replys_chunks():
 
 
 def test_a_failed_chunk_drops_the_rest_of_its_stream_and_reports_once(caplog):
+    caplog.set_level(logging.INFO)
     voice, failures = RecordingVoice(fail_on=1), []
     sender = VoiceSender(voice, "emopose", failures.append)
     sender.queue([Chunk("a", b"\0\0", 0.0, 0.1), Chunk("a", b"\0\0", 0.0, 0.2)], FakeClock())
@@ -101,6 +103,7 @@ def test_a_failed_chunk_drops_the_rest_of_its_stream_and_reports_once(caplog):
     sender.close()
     assert voice.calls == [("chunk", "a", 2)] and sender.failures == 1
     assert "its 1 later chunk(s) are not sent" in caplog.text
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]  # the player warns, once
 
 
 def test_the_chest_light_shows_the_latest_state_of_a_burst():
