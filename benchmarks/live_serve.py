@@ -21,6 +21,7 @@ Run: python benchmarks/live_serve.py [--items 320] [--busy 1] [--pages 0] [--ext
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import signal
@@ -30,6 +31,7 @@ import sys
 import threading
 import time
 import urllib.request
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +51,18 @@ from run_dirs import measure_and_print  # noqa: E402
 SUITE = ROOT / "experiments" / "sequence" / "sequence_suite.jsonl"
 LIMITS = ROOT / "library" / "g1" / "limits.yaml"  # the default library set's (serve's default)
 BUSY_LOOP = "while True:\n    pass\n"
+
+
+@contextlib.contextmanager
+def busy_cores(n: int) -> Iterator[None]:
+    """n other processes, each keeping a core busy, while inside (issue 28's load; serve_soak.py --busy)."""
+    busy = [subprocess.Popen([sys.executable, "-c", BUSY_LOOP]) for _ in range(n)]
+    try:
+        yield
+    finally:
+        for process in busy:
+            process.kill()
+            process.wait()
 
 
 def free_port() -> int:
@@ -164,25 +178,22 @@ def measure(args: argparse.Namespace, run_dir: Path) -> dict:
     items = [json.loads(line) for line in SUITE.read_text().splitlines() if line.strip()][: args.items]
     port = free_port()
     env = {**os.environ, "MUJOCO_GL": os.environ.get("MUJOCO_GL", "egl"), "HF_HUB_OFFLINE": "1"}
-    busy = [subprocess.Popen([sys.executable, "-c", BUSY_LOOP]) for _ in range(args.busy)]
-    with open(run_dir / "serve.log", "w") as serve_log:
-        server = subprocess.Popen(serve_command(port, run_dir, args.extra), cwd=ROOT, env=env,
-                                  stdout=subprocess.DEVNULL, stderr=serve_log)
     stop_pages = threading.Event()
-    try:
-        wait_ready(port, server)
-        for _ in range(args.pages):
-            threading.Thread(target=watch, args=(port, stop_pages), daemon=True).start()
-        started = time.monotonic()
-        turns = drive(port, [item["text"] for item in items])
-        driven_s = time.monotonic() - started
-    finally:
-        stop_pages.set()
-        server.send_signal(signal.SIGTERM)
-        server.wait(timeout=120)
-        for process in busy:
-            process.kill()
-            process.wait()
+    with busy_cores(args.busy):
+        with open(run_dir / "serve.log", "w") as serve_log:
+            server = subprocess.Popen(serve_command(port, run_dir, args.extra), cwd=ROOT, env=env,
+                                      stdout=subprocess.DEVNULL, stderr=serve_log)
+        try:
+            wait_ready(port, server)
+            for _ in range(args.pages):
+                threading.Thread(target=watch, args=(port, stop_pages), daemon=True).start()
+            started = time.monotonic()
+            turns = drive(port, [item["text"] for item in items])
+            driven_s = time.monotonic() - started
+        finally:
+            stop_pages.set()
+            server.send_signal(signal.SIGTERM)
+            server.wait(timeout=120)
     rows = read_stroke_sync(run_dir / "session.mcap")
     results = json.loads((run_dir / "results.json").read_text())
     loop = results["loop"]

@@ -10,13 +10,14 @@ seconds on a loaded machine (hence the imports inside the functions below). SIGT
 exits 143 / 130. Once main() knows the run directory, results.json says the run was interrupted (written
 here if the job had not written its own yet, so a reused directory never keeps an earlier run's results);
 before that, one line on stderr says that no results were written. Only the interpreter's start and
-`import emopose` (a fraction of a second) come before the handler.
+`import emopose` with this module's first lines (about 5 ms beyond the interpreter's own start; json and
+logging are imported later) come before the handler; a SIGTERM there exits 143 with nothing written, and
+since no run directory exists yet, nothing is lost.
 """
 
 from __future__ import annotations
 
 import importlib
-import json
 import os
 import sys
 from pathlib import Path
@@ -87,6 +88,8 @@ def results_stamp(run_dir: Path) -> tuple[int, int, int] | None:
 
 def finished_writing(run_dir: Path, earlier: tuple[int, int, int] | None) -> bool:
     """Whether this run replaced the `earlier` results.json with its outcome (not its in-progress marker)."""
+    import json  # not at the top: the stop-signal handler comes first (see the module's docstring)
+
     now = results_stamp(run_dir)
     if now is None or now == earlier:
         return False

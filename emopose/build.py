@@ -23,6 +23,7 @@ from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.planners.base import CheckedPlanner, Planner
 from emopose.resources import Resources, Run
 from emopose.scene.view import SceneSlot
+from emopose.speech.audio_channel import SpeechRecording
 from emopose.speech.player import Player
 from emopose.turn.pipeline import Pipeline, PipelineError
 from emopose.turn.runner import TurnRunner
@@ -127,6 +128,7 @@ def build_run(cfg: DictConfig, run_dir: str | Path) -> Run:
                           asr=make(cfg.get("asr"), "asr"), scene=scene, run_dir=Path(run_dir))
     session = Session(backend, loop, library.neutral_entry.q[0], run_dir, record=bool(cfg.run.record))
     sequencer.on_event = session.record_event
+    player.on_play = SpeechRecording(session.record_at)  # what was said and heard, in the recording
     thinking = make_with(cfg.get("thinking"), "thinking", shared)
     return Run(resources, session, TurnRunner(planner, pipeline, session, thinking))
 

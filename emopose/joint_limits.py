@@ -61,6 +61,17 @@ class JointLimits:
         velocity = self.max_velocity * self.speed_fraction
         return JointLimits(self.names, self.lower + m, self.upper - m, velocity)
 
+    def target_bounds(self, margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """Where a gesture's target poses may lie: `margin` inside the hard limits (the paper's delta), and no
+        closer than the tracking reserve's margin, where commands are clipped (a target beyond it would
+        never be reached, its stroke never arrive)."""
+        m = max(margin, self.limit_margin)
+        return self.lower + m, self.upper - m
+
+    def keep_inside(self, q: np.ndarray, margin: float = 0.0) -> np.ndarray:
+        """Pi_j of Eq. intensity: clip target poses into target_bounds(margin); (14,) or (T, 14)."""
+        return np.clip(q, *self.target_bounds(margin))
+
     def project(self, q: np.ndarray, margin: float = 0.0) -> np.ndarray:
         """Pi_j: clip into [q- + margin, q+ - margin] joint-wise; works on (14,) or (T, 14)."""
         return np.clip(q, self.lower + margin, self.upper - margin)

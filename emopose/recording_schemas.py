@@ -152,6 +152,21 @@ SCHEMAS: dict[str, dict] = {
         words=array(obj(text=STRING, char_start=INTEGER, char_end=INTEGER, start_s=NUMBER)),
         gestures=array(TIMELINE_GESTURE),
     ),
+    "/speech/said": {
+        **obj(t=SESSION_TIME, text=STRING, duration_s=NUMBER, audio=BOOLEAN),
+        "description": "each clip the player started, at its start (emopose/speech/audio_channel.py)",
+    },
+    "/speech/audio": {
+        **obj(
+            t=SESSION_TIME,
+            offset_s={**NUMBER, "description": "s into its clip"},
+            format={"type": "string", "enum": ["pcm-s16"]},
+            sample_rate=INTEGER,
+            number_of_channels=INTEGER,
+            data={**STRING, "contentEncoding": "base64", "description": "little-endian PCM16 samples"},
+        ),
+        "description": "the spoken audio as heard, in chunks at their play-clock time (Foxglove RawAudio)",
+    },
     "/sequencer/events": EVENT,
     "/joints/command": obj(t=SESSION_TIME, q=JOINTS),
     "/joints/sim": obj(t=SESSION_TIME, q=JOINTS),

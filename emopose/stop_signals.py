@@ -15,18 +15,17 @@ ctypes.ArgumentError). app.run turns either back into the interrupt, so every jo
 results and the same exit status: 143 after SIGTERM, 130 after SIGINT.
 
 `python -m emopose` enters stop_signals_interrupt() before it imports anything else (emopose/__main__.py),
-so this module imports only the standard library: a signal during those seconds of imports is handled too.
+so this module imports only small standard modules (logging and what it pulls in, ~20 ms, only once a
+second SIGTERM needs it): a signal during the seconds of imports after it is handled too, and the window
+before it is the interpreter's start and a few ms (tests/test_main_imports.py).
 """
 
 from __future__ import annotations
 
 import contextlib
-import logging
 import signal
 import threading
 from collections.abc import Iterator
-
-log = logging.getLogger(__name__)
 
 _requested: list[KeyboardInterrupt] = []  # the first stop signal's interrupt inside stop_signals_interrupt()
 
@@ -68,7 +67,10 @@ def stop_signals_interrupt() -> Iterator[None]:
 
     def on_sigterm(signum: int, frame: object) -> None:
         if terminated:
-            log.warning("SIGTERM again: still releasing the robot and closing the recording")
+            import logging  # here, not at the top: see the module's last paragraph
+
+            logging.getLogger(__name__).warning(
+                "SIGTERM again: still releasing the robot and closing the recording")
             return
         terminated.append(signum)
         raise _remember(Terminated())

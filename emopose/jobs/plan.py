@@ -44,6 +44,7 @@ class PlanJob:
             "completed": turn.dispatched.completed,
             "mcap": str(recorder.path) if recorder else None,
             "stage_ms": data["stage_ms"],
+            "loop": run.session.loop.stats.summary(),  # missed deadlines, stalls, lateness (real time)
             "turn": data,  # every value of the turn, as the MCAP recording holds it
         }
         text = (f"Utterance: {self.utterance}\nReply: {turn.plan.reply}  (plan from {turn.plan.source}, "

@@ -54,12 +54,12 @@ class ServeJob:
         session = open_session(run, self.settings, render=self.render)  # the renderer first: it holds the GIL
         loop, stopped_by = run.session.open(), None
         try:
-            loop.start(self.rt_priority)
             s = self.settings
-            print(f"EmoPose UI: http://{s.host}:{s.port}/  (Pose Studio: /studio)"
-                  + ("  -- open it with ?token=<serve.token>" if s.token else ""), flush=True)
             config = uvicorn.Config(create_app(session), ws_max_size=s.max_ws_message_bytes,
                                     log_level="warning", access_log=False)
+            loop.start(self.rt_priority)  # after everything is loaded: it freezes the survivors for the GC
+            print(f"EmoPose UI: http://{s.host}:{s.port}/  (Pose Studio: /studio)"
+                  + ("  -- open it with ?token=<serve.token>" if s.token else ""), flush=True)
             try:
                 uvicorn.Server(config).run(sockets=[listener])
             except KeyboardInterrupt as interrupt:  # uvicorn stopped gracefully, then raised the signal

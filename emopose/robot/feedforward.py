@@ -26,7 +26,7 @@ class GravityModel:
         from emopose.robot.model import build_model
 
         self._mj = mujoco
-        self.model = build_model(model_path)
+        self.model = build_model(model_path, meshes=False)  # physics only: no visuals to compile
         self.data = mujoco.MjData(self.model)
         joints = [self.model.joint(n) for n in JOINT_NAMES]
         self._qadr = np.array([j.qposadr[0] for j in joints])

@@ -7,9 +7,12 @@ module stays cheap for dry-run code paths.
 
 from __future__ import annotations
 
+import copy
+import functools
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from emopose.robot import appearance
 from emopose.robot.g1_spec import JOINT_NAMES
 
 if TYPE_CHECKING:
@@ -25,10 +28,13 @@ class ModelError(ValueError):
 
 
 def build_spec(
-    model_path: str | Path | None = None, planar_base: bool = False, base_kv: float = 400.0
+    model_path: str | Path | None = None, planar_base: bool = False, base_kv: float = 400.0,
+    meshes: bool = True,
 ) -> mujoco.MjSpec:
     """The model as an editable MjSpec.
 
+    meshes dresses the robot in Unitree's meshes when the `g1-meshes` extra is installed
+    (emopose.robot.appearance: visual-only geoms; the dynamics and contacts stay the model's).
     planar_base adds slide x, slide y and hinge yaw joints on the pelvis (world-frame slides,
     declared before the hinge), each driven by a velocity actuator of the same name, so the tour
     can drive the base like the G1's sport service does (vx, vy, yaw rate).
@@ -42,6 +48,8 @@ def build_spec(
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as exc:  # mujoco reports XML and schema errors as ValueError
         raise ModelError(f"MJCF {path} cannot be loaded: {str(exc).strip()}") from exc
+    if meshes:
+        appearance.attach_meshes(spec)
     if not planar_base:
         return spec
     pelvis = spec.body("pelvis")
@@ -54,9 +62,24 @@ def build_spec(
     return spec
 
 
-def build_model(model_path: str | Path | None = None, planar_base: bool = False) -> mujoco.MjModel:
-    """Compile the upper body (fixed base by default)."""
-    spec = build_spec(model_path, planar_base=planar_base)
+def build_model(
+    model_path: str | Path | None = None, planar_base: bool = False, meshes: bool = True
+) -> mujoco.MjModel:
+    """Compile the upper body (fixed base by default).
+
+    Each caller gets its own copy of one compilation per file version: compiling Unitree's meshes takes
+    over a second, copying the result a fraction of that.
+    """
+    path = Path(model_path or ASSET_PATH)
+    version = (path.stat().st_mtime_ns, path.stat().st_size) if path.is_file() else None
+    dressing = appearance.description_path() if meshes else None
+    return copy.copy(_compiled(model_path, version, planar_base, meshes, dressing))
+
+
+@functools.lru_cache(maxsize=8)
+def _compiled(model_path, version, planar_base: bool, meshes: bool, dressing) -> mujoco.MjModel:
+    """build_model's compilation; version and dressing (the meshes' source) only key the cache."""
+    spec = build_spec(model_path, planar_base=planar_base, meshes=meshes)
     try:
         model = spec.compile()
     except ValueError as exc:

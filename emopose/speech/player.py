@@ -19,6 +19,7 @@ import logging
 import shutil
 import subprocess
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 from emopose.clock import Clock
@@ -46,6 +47,8 @@ class Player:
         self.ends_at: float | None = None
         self.clip: SpeechClip | None = None  # the clip started last (the echo gate's reference)
         self.last_sink = "none"
+        # on_play(clip, start): told of every clip started (the recording's /speech/said and /speech/audio)
+        self.on_play: Callable[[SpeechClip, float], None] | None = None
 
     # -- public --------------------------------------------------------------------------------
     def play(self, clip: SpeechClip, clock: Clock, follow: bool = False) -> float:
@@ -58,6 +61,8 @@ class Player:
             if start is None:
                 self.last_sink, start = "none", clock.now()
         self.clip, self.started_at, self.ends_at = clip, start, start + clip.duration_s
+        if self.on_play is not None:
+            self.on_play(clip, start)
         return start
 
     def expected_latency_s(self, clip: SpeechClip, clock: Clock) -> float:

@@ -128,7 +128,7 @@ class AimStage:
         return aimed, report
 
     def _solve(self, keyframes: np.ndarray, side: int, target: np.ndarray, limits, abduction: float):
-        lower, upper = limits.lower + self.margin, limits.upper - self.margin
+        lower, upper = limits.target_bounds(self.margin)
         roll = side * ARM_DOF + 1  # shoulder roll: + moves the left arm out, - the right
         aimed, errors, converged = keyframes.copy(), [], True
         for k in peak_indices(aimed, side, self.peak_fraction):

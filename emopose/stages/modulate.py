@@ -3,7 +3,8 @@
 q~_kj = q_kj                                    if i = 3 or k in {0, K-1}
       = Pi_j(q_0j + a_i (q_kj - q_0j))          otherwise,
 with a = (0.4, 0.6, 1.0, 1.3, 1.6) for i = 1..5 and Pi_j the clip into [q-_j + delta, q+_j - delta].
-Duration is invariant.
+Duration is invariant. Beyond the paper: where the limits file's tracking reserve keeps commands further
+inside than delta, Pi_j clips there (JointLimits.keep_inside), so the stroke pose is one the arm is sent to.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ def modulate_keyframes(q: np.ndarray, intensity: int, limits: JointLimits,
     out = np.array(q, dtype=float)
     if intensity == 3 or len(out) < 3:
         return out
-    out[1:-1] = limits.project(scale_excursion(out, gains[intensity - 1])[1:-1], margin)
+    out[1:-1] = limits.keep_inside(scale_excursion(out, gains[intensity - 1])[1:-1], margin)
     return out
 
 

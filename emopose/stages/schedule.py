@@ -9,8 +9,8 @@ back to the anchor equation where it has no word timings. Trigger search is case
 timeline mode (the default, beyond the paper) takes the words-mode times as the onsets the strokes must
 meet and plans every gesture's keyframe times around them (emopose/turn/timeline.py); its release is the
 gesture's start, possibly before the speech (the pre-roll); the sequencer's published pose tells it
-where the arm is, so a first gesture that starts away from rest still lands on its word; a first gesture
-that would still land late is played softer where that fits (`first_word`, emopose/stages/first_gesture.py).
+where the arm is, so a first gesture that starts away from rest still lands on its word; a gesture that
+would land late or find no room is played softer where that fits (`softening`, emopose/stages/softening.py).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from emopose.execution.sequencer import Sequencer
 from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.joint_limits import JointLimits
 from emopose.speech.clip import SpeechClip, Synthesizer
-from emopose.stages.first_gesture import FirstWordSettings, plan_fitting_first
+from emopose.stages.softening import SofteningSettings, plan_softening
 from emopose.turn.model import Release, ReleaseRule, Schedule, Turn
 from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 
@@ -87,7 +87,7 @@ class ScheduleStage:
     sequencer: Sequencer | None = field(default=None, repr=False)
     mode: Literal["anchor", "words", "timeline"] = "timeline"
     timeline: TimelineSettings = field(default_factory=TimelineSettings)
-    first_word: FirstWordSettings = field(default_factory=FirstWordSettings)
+    softening: SofteningSettings = field(default_factory=SofteningSettings)
     name = "schedule"
     reads = ("plan", "modulated")
     writes = ("speech", "schedule")
@@ -121,8 +121,8 @@ class ScheduleStage:
             return speech, Schedule(reply, releases, tuple(turn.modulated))
         arm = None if self.sequencer is None else self.sequencer.last
         onsets = [t for t, _ in times]
-        gestures, placed, preroll = plan_fitting_first(self._planner, list(turn.modulated), onsets, arm,
-                                                       self.first_word)
+        gestures, placed, preroll = plan_softening(self._planner, list(turn.modulated), onsets, arm,
+                                                   self.softening)
         releases = tuple(
             Release(timing.times[0], how, ok, timing=timing) if not isinstance(timing, str)
             else Release(t, how, ok, dropped=timing)

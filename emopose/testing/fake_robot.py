@@ -8,7 +8,8 @@ first-order lag (tau 0.05 s), w = motor_cmd[29].q (w = 0: the firmware holds its
 Answers the loco RPCs (see fake_loco.py) and the voice RPCs, and streams a WAV as its microphone
 (see fake_voice.py). --log writes one JSON line per received arm command
 (q, weight, modes, gains, crc_ok; t when taken, sent_ns when the sender wrote it: the
-batch-free send time), per loco request, and a final summary. Prints READY when up.
+batch-free send time), per loco request, and a final summary. Prints READY when up. SIGUSR1 stops
+rt/lowstate for good (the arms' state lost, the loco and voice services still answering).
 """
 
 from __future__ import annotations
@@ -79,6 +80,7 @@ class FakeG1:
         self._weight = 0.0
         self._cmd_lock = threading.Lock()
         self.good = self.bad_crc = self.undecodable = 0
+        self.lowstate_on = True
         self._stop = threading.Event()
         self._commands = Worker("fake-arm-sdk", self._take_commands, join_timeout_s=1.0)
         self._record = wire.new_lowstate()
@@ -162,10 +164,15 @@ class FakeG1:
             last = now
             if self.args.duration and now - start >= self.args.duration:
                 break
-            self._publish_state(int((now - start) * 1000))
+            if self.lowstate_on:
+                self._publish_state(int((now - start) * 1000))
 
     def stop(self, *_: object) -> None:
         self._stop.set()
+
+    def silence_lowstate(self, *_: object) -> None:
+        self.lowstate_on = False
+        self.log({"kind": "lowstate_silenced", "t": time.monotonic()})
 
     def close(self) -> None:
         self._stop.set()
@@ -197,12 +204,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     p.add_argument(
         "--network-interface", default=None, help="NIC name or IP (default: Cyclone's choice)"
     )
-    p.add_argument(
-        "--duration", type=float, default=0.0, help="seconds to run (0: until SIGTERM/SIGINT)"
-    )
-    p.add_argument(
-        "--log", default=None, help="JSONL file: every arm command, loco request, summary"
-    )
+    p.add_argument("--duration", type=float, default=0.0, help="seconds to run (0: until SIGTERM/SIGINT)")
+    p.add_argument("--log", default=None, help="JSONL file: every arm command, loco request, summary")
     p.add_argument("--lowstate-hz", type=float, default=500.0)
     p.add_argument("--tau", type=float, default=0.05, help="joint response time constant, s")
     p.add_argument(
@@ -234,6 +237,7 @@ def main(argv: list[str] | None = None) -> int:
     robot = FakeG1(parse_args(argv))
     signal.signal(signal.SIGTERM, robot.stop)
     signal.signal(signal.SIGINT, robot.stop)
+    signal.signal(signal.SIGUSR1, robot.silence_lowstate)
     try:
         robot.run()
     finally:

@@ -1,21 +1,22 @@
 """+experiment=tour_lab: the guided tour, headless in simulation (or on the G1), with a full report.
 
-Simulation: the MuJoCo backend with its planar base, the tour's objects added to the scene, a
-virtual clock (the tour ticks the loop itself, so it runs faster than real time) and a low-rate
-video from the overview camera. Writes session.mcap, tour.mp4 and results.json / results.md into
-the run directory. The base the tour walks on is the `tour/base` config group (job.base): sim, or g1
-(the loco service on onboard odometry).
+Simulation: the MuJoCo backend with its planar base, the tour's objects added to the scene and a
+virtual clock (the tour ticks the loop itself, so it runs faster than real time); after the tour, the
+video is rendered from the recording in a child process (emopose/tour/video.py). Writes session.mcap,
+tour.mp4 (+ tour.vtt captions) and results.json / results.md into the run directory. The base the
+tour walks on is the `tour/base` config group (job.base): sim, or g1 (the loco service on onboard
+odometry).
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Protocol
 
 from emopose.backends.base import Backend
-from emopose.backends.capabilities import SimulatedState
 from emopose.execution.control_loop import check_rt_priority
 from emopose.library import MotionLibrary
 from emopose.planners.base import Planner
@@ -27,6 +28,7 @@ from emopose.tour.runner import TourRunner
 from emopose.tour.scenario import TourConfigError, TourSpec
 from emopose.tour.scenario_loading import load_tour, parse_tour
 from emopose.tour.sim_scene import install_scene
+from emopose.tour.video import VideoSettings, make_video
 
 log = logging.getLogger(__name__)
 
@@ -46,12 +48,17 @@ class TourJob:
     tour_file: str | None = None  # or a scenario file of your own (wins over `tour`)
     answer_planner: dict | None = None  # planner config for questions (the experiment passes ${planner})
     answer_mode: str = "respond"  # planners with a `mode` answer visitors in this mode
-    video: bool = True
+    video: bool = True  # tour.mp4 in simulation, rendered from the recording after the tour
+    video_settings: dict = field(default_factory=dict)  # VideoSettings fields (size, fps, camera)
     base: dict | None = None  # the tour/base node (conf/tour/base/), built by build.make
     rt_priority: int = 0  # run.rt_priority: the control loop thread's SCHED_FIFO priority in real time
 
     def __post_init__(self) -> None:
         check_rt_priority(self.rt_priority)
+        try:
+            self._video = VideoSettings(**self.video_settings)
+        except (TypeError, ValueError) as exc:
+            raise TourConfigError(f"job.video_settings: {exc}") from exc
 
     def load(self) -> TourSpec:
         if self.tour_file:
@@ -64,7 +71,7 @@ class TourJob:
 
     def __call__(self, run: Run) -> JobOutput:
         spec, res, tour_base = self.load(), run.resources, self.tour_base()
-        install_scene(res.backend, spec, res.run_dir, self.video)
+        scene = install_scene(res.backend, spec, res.run_dir)
         loop = run.session.open()
         base = tour_base.open(res.backend, spec)
         if res.clock.realtime:
@@ -77,14 +84,27 @@ class TourJob:
         finally:
             tour_base.close()  # the runner has already stopped the base
         wall_s = time.perf_counter() - started
+        video = self.render_video(run, scene)
         results = {**report.as_dict(), "wall_time_s": wall_s,
                    "realtime_factor": report.sim_time_s / wall_s if wall_s > 0 else None,
                    "planner": res.planner.name, "backend": res.backend.name,
                    "stop_tolerance_m": spec.navigation.stop_tolerance_m,
                    "mcap": str(run.session.recorder.path) if run.session.recorder else None,
-                   "video": (res.backend.renderer.video_path if isinstance(res.backend, SimulatedState)
-                             else None)}
+                   **video}
         return results, report.markdown() + f"\n\nWall time {wall_s:.1f} s."
+
+    def render_video(self, run: Run, scene: Path | None) -> dict:
+        """tour.mp4 from the finished recording (simulation only); a failure is reported, the tour kept."""
+        recorder, started = run.session.recorder, time.perf_counter()
+        if not self.video or scene is None or recorder is None:
+            return {"video": None}
+        run.session.close()  # the recording is complete (`with run:` closing it again does nothing)
+        try:
+            path = make_video(recorder.path, scene, run.resources.run_dir / "tour.mp4", self._video)
+        except Exception as exc:  # noqa: BLE001 -- no GL, no ffmpeg: the tour's results stand without it
+            log.warning("tour video not made: %s", exc)
+            return {"video": None, "video_error": f"{type(exc).__name__}: {exc}"[:300]}
+        return {"video": str(path), "video_wall_s": time.perf_counter() - started}
 
     def tour_base(self) -> TourBase:
         if not self.base:

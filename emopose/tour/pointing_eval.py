@@ -52,7 +52,7 @@ class PointingEvalJob:
             raise TourConfigError("pointing_eval measures in simulation with a planar base: use "
                                   "backend=mujoco with a backend.planar_base (as +experiment=pointing_eval "
                                   "sets)")
-        install_scene(res.backend, spec, res.run_dir, video=False)
+        install_scene(res.backend, spec, res.run_dir)
         run.session.open()
         base = MujocoBase(res.backend.planar_base)
         entry = res.library.get(self.gesture) if self.gesture else res.library.class_default("pointing")

@@ -7,6 +7,8 @@ stops the base, clears pending gestures with a blend, is answered through the pi
 whole tour's dialogue history (and the head camera frame when it asks about the scene), and the
 tour resumes: the leg from where the base stopped, the narration from the interrupted sentence.
 "Stop the tour" ends it. Whatever happens, run() leaves the base stopped and the arms at neutral.
+With a G1 connected the chest light follows the tour as it follows serve (emopose/turn/state_light.py:
+listening, thinking from a line's request until its audio starts, speaking, fault; off when the tour ends).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from emopose.tour.report import Exchange, StopResult, TourReport
 from emopose.tour.scenario import StopSpec, TourSpec
 from emopose.tour.voice import Line, TourVoice, sentence_chunks
 from emopose.tour.world import TourWorld
+from emopose.turn.state_light import chest_light_for
 
 log = logging.getLogger(__name__)
 
@@ -49,6 +52,7 @@ class TourRunner:
         self.interruptions = interruptions or Interruptions(spec.interruptions)
         self.answer_planner = answer_planner or res.planner
         self.report = TourReport(spec.name)
+        self.open_light = partial(chest_light_for, res, lambda: self.voice.preparing)
         self.aborted = False
         self._moving_when_asked = False
 
@@ -56,6 +60,7 @@ class TourRunner:
     def run(self) -> TourReport:
         first_event = self.sequencer.events.total
         self.event("start", pose=self.base.odometry().as_dict())
+        light = self.open_light()
         try:
             for stop in self.spec.stops_in_order:
                 result = self.walk_to(stop)
@@ -70,6 +75,8 @@ class TourRunner:
                 self.turns.dialogue.said(closing.text)
         finally:
             self.come_to_rest()
+            if light is not None:
+                light.close()
             self.report.finish(self.sequencer.events.since(first_event), self.aborted,
                                [q.text for q in self.interruptions.unasked])
             self.event("end", aborted=self.aborted, at_rest=self.report.ended_at_rest)

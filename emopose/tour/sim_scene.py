@@ -2,8 +2,8 @@
 
 write_scene() saves an MJCF next to the run's outputs and points the MuJoCo backend at it before it
 connects, so the backend itself stays the plain one (planar base, servos, recorder). Also adds
-`tour_overview`, a fixed camera high above the arena that keeps the robot in frame for the video,
-and drops shadows and floor reflections, which cost most of a software-rendered frame.
+`tour_overview`, a fixed camera high above the arena that keeps the robot in sight, and drops shadows
+and floor reflections, which cost most of a software-rendered frame.
 """
 
 from __future__ import annotations
@@ -58,15 +58,16 @@ def write_scene(spec: TourSpec, path: str | Path, model_path: str | Path | None 
     return path
 
 
-def install_scene(backend, spec: TourSpec, run_dir: Path, video: bool = True) -> None:
-    """Point a not-yet-connected MuJoCo backend at the tour scene (and the video into run_dir)."""
+def install_scene(backend, spec: TourSpec, run_dir: Path) -> Path | None:
+    """Point a not-yet-connected MuJoCo backend at the tour scene (written into run_dir); its path, which
+    the tour video is rendered with (emopose/tour/video.py). None: not a simulation."""
     if not isinstance(backend, SimulatedState):
-        return
+        return None
     if backend.data is not None:
         raise RuntimeError("install_scene must run before the backend connects (before session.open())")
     # mujoco reads MUJOCO_GL at its first import, which is about to happen here rather than in
     # connect(): choose the GL platform the way the backend would.
     backend.select_gl()
-    backend.model_path = str(write_scene(spec, run_dir / "tour_scene.xml", backend.model_path))
-    if video and backend.renderer.video_path is None:
-        backend.renderer.video_path = str(run_dir / "tour.mp4")
+    scene = write_scene(spec, run_dir / "tour_scene.xml", backend.model_path)
+    backend.model_path = str(scene)
+    return scene

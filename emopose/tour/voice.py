@@ -4,12 +4,14 @@ perform() runs the line as a turn through the turn runner; the tour pipeline (co
 dispatches without blocking, so it returns once the gestures are queued against the speech start, and
 finish() then advances the world until the speech has ended and the arms have settled, polling for a
 visitor's question, which cuts the line short. speak_only() is speech without gestures (lines said
-while walking).
+while walking). `preparing` is true from a line's request until its audio starts (planning, synthesis,
+the timeline): the chest light's "thinking", with no "listening" flicker before the robot speaks.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from emopose.contract import MAX_REPLY_CHARS
@@ -70,6 +72,15 @@ class TourVoice:
                  sequencer: Sequencer) -> None:
         self.world, self.turns = world, turns
         self.synthesizer, self.player, self.sequencer = synthesizer, player, sequencer
+        self.preparing = False  # a line is being planned or synthesized (read by the chest light's thread)
+
+    @contextmanager
+    def _preparing(self) -> Iterator[None]:
+        self.preparing = True
+        try:
+            yield
+        finally:
+            self.preparing = False
 
     def perform(self, utterance: str, kind: str, image: bytes | None = None, planner: Planner | None = None,
                 question: str | None = None) -> Line:
@@ -77,12 +88,14 @@ class TourVoice:
         saying it with its gestures."""
         # The tour adds to the dialogue itself once a line has been said: a narration line is the robot's
         # own (no visitor said it), and a line cut short counts only as far as it was spoken.
-        turn = self.turns.run(utterance, image, planner=planner, question=question, remember=False)
+        with self._preparing():
+            turn = self.turns.run(utterance, image, planner=planner, question=question, remember=False)
         return Line(kind, turn.plan.reply, turn.speech, turn.dispatched.speech_start, turn)
 
     def speak_only(self, text: str, kind: str) -> Line:
-        speech = self.synthesizer.synthesize(text)
-        start = self.player.play(speech, self.world.clock)
+        with self._preparing():
+            speech = self.synthesizer.synthesize(text)
+            start = self.player.play(speech, self.world.clock)
         self.world.record("/tour/speech", {"kind": kind, "text": text, "duration_s": speech.duration_s})
         return Line(kind, text, speech, start)
 

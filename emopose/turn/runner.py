@@ -49,7 +49,8 @@ class TurnRunner:
         self.dialogue.on_message = self.session.write  # each message once, on /dialogue
         self._stream: SentencePlans | None = None  # the reply streaming now, for cancel()
         self._stream_lock = threading.Lock()
-        self._planner_call = AbandonableCall()  # the planner call under way, for cancel_planning()
+        # the planner call under way (or announced: expect()), for cancel_planning()
+        self.planner_call = AbandonableCall()
         self._planning = 0  # planner calls under way (the chest light's "thinking")
 
     def with_pipeline(self, pipeline: Pipeline) -> TurnRunner:
@@ -110,8 +111,9 @@ class TurnRunner:
                              "use planner=annotate planner.stream=true")
         self.session.open()
         request = self.dialogue.request(utterance, image)
-        plans = self.planner.stream(request)
-        with self._stream_lock:
+        with self._stream_lock:  # a Cancel before this is honoured by claim(), one after by cancel()
+            self.planner_call.claim()
+            plans = self.planner.stream(request)
             self._stream, reply = plans, StreamedReply([])
         try:
             self._perform(request, plans, reply, on_turn or (lambda turn: None))
@@ -136,7 +138,7 @@ class TurnRunner:
     def cancel_planning(self) -> bool:
         """Abandon the planner call under way, from any thread: its turn raises PlanningCancelled (the
         thinking gesture stops, nothing joins the dialogue) and the answer is dropped. False: no call was."""
-        return self._planner_call.abandon()
+        return self.planner_call.abandon()
 
     def silence(self) -> None:
         """Stop talking and clear the gestures now, from any thread: a reply still streaming stops first (no
@@ -199,7 +201,7 @@ class TurnRunner:
         """The planner call, wrapped in the thinking gesture that masks its latency."""
         thinking = self.thinking.around_planning() if self.thinking is not None else nullcontext()
         with self._planning_now(), thinking:
-            turn.planner_output = self._planner_call.run(lambda: planner.plan(turn.request))
+            turn.planner_output = self.planner_call.run(lambda: planner.plan(turn.request))
         turn.stage_s["planner"] = turn.planner_output.latency_s
         self._record(turn, "planner_output")
 

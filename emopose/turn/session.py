@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from emopose.backends.base import Backend
+from emopose.execution.collector import freeze_survivors
 from emopose.execution.control_loop import ControlLoop
 from emopose.execution.gesture_command import Event
 from emopose.recording import Recorder
@@ -50,6 +51,8 @@ class Session:
             self.recorder = Recorder(self.run_dir / "session.mcap", clock=self.loop.clock)
         if self.origin is None:
             self.origin = self.recorder.origin if self.recorder is not None else self.loop.clock.now()
+        if self.loop.clock.realtime:
+            freeze_survivors()  # a collector pause over set-up's objects would stall the robot's stream
         measured = self.backend.connect(self.recorder)
         q0 = self.neutral if measured is None else np.asarray(measured, dtype=float)
         self.loop.begin(q0, self.recorder)
@@ -70,6 +73,12 @@ class Session:
         """Record a message at the current time (nothing before open() or without a recorder)."""
         if self.recording:
             self.recorder.write_now(topic, payload)
+
+    def record_at(self, topic: str, clock_time: float, payload: dict) -> None:
+        """Record a message at a loop-clock time (now or ahead: a clip's samples as they will be heard);
+        its `t` is that time on the session clock."""
+        if self.recording:
+            self.recorder.write(topic, self.loop.stream_time_of(clock_time), payload)
 
     def record_event(self, event: Event) -> None:
         """The sequencer's on_event callback: each event on /sequencer/events, on the stream's time base.

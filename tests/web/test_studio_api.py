@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 import yaml
 
@@ -32,10 +33,12 @@ def test_studio_check_builds_the_50hz_trajectory_with_the_duration_rule(client):
 
 
 def test_studio_checks_the_start_poses_a_motion_can_meet(client):
-    """hands_on_heart passes from rest but collides at intensity 4 after neutral_ready's held end pose:
-    the check says so (a warning, with what it checked) instead of passing it silently."""
-    heart = client.get("/api/library/hands_on_heart").json()
-    report = client.post("/api/studio/check", json={"keyframes": heart["keyframes"]}).json()
+    """A hands-on-heart draft (the library's, its interior 6 % nearer its first keyframe) passes from rest but
+    collides at intensity 4 after neutral_ready's held end pose: the check says so (a warning, with what it
+    checked) instead of passing it silently."""
+    heart = np.array(client.get("/api/library/hands_on_heart").json()["keyframes"])
+    heart[1:-1] = heart[0] + 0.94 * (heart[1:-1] - heart[0])
+    report = client.post("/api/studio/check", json={"keyframes": heart.tolist()}).json()
     assert report["can_save"] and all(c["ok"] for c in report["levels"])  # from rest
     ready = [c for c in report["starts"] if "neutral_ready" in c["start"]]
     assert ready and ready[0]["failed_levels"] == [4] and "clearance" in ready[0]["reason"]

@@ -29,6 +29,9 @@ _IFACE_XML = """<?xml version="1.0" encoding="UTF-8" ?>
 # A Cyclone domain can be configured once per process; remember what we configured it with.
 _DOMAINS: dict[int, tuple[str | None, Any]] = {}
 _DOMAINS_LOCK = threading.Lock()
+# cyclonedds fills a type's XTypes data lazily on its first Topic and not thread-safely (two threads at
+# once: AttributeError or a crash; serve's chest light and the backend's connect did): one at a time.
+_TOPICS_LOCK = threading.Lock()
 
 
 def describe(domain_id: int, network_interface: str | None) -> str:
@@ -147,9 +150,10 @@ class DdsSession:
         self._topics: dict[str, Topic] = {}
 
     def _topic(self, name: str, data_type: type) -> Topic:
-        if name not in self._topics:
-            self._topics[name] = Topic(self.participant, name, data_type)
-        return self._topics[name]
+        with _TOPICS_LOCK:
+            if name not in self._topics:
+                self._topics[name] = Topic(self.participant, name, data_type)
+            return self._topics[name]
 
     def reader(self, name: str, data_type: type, qos: Qos | None = None) -> RawReader:
         """Default QoS (as Unitree's SDK uses) unless given: best effort, keep last 1."""

@@ -3,6 +3,7 @@ import { api, connect, el, fillBadges } from "./common.js";
 import { markOutcome, markStroke, ReplyPlayer, setSourceWords, showFailure, showPlayed, turnBubble } from "./cues.js";
 import { cancelledNote, PlanningBubble } from "./planning.js";
 import { ReportPanel } from "./report.js";
+import { Microphone } from "./mic.js";
 import { RobotPanel } from "./robot.js";
 
 const $ = (id) => document.getElementById(id);
@@ -91,6 +92,7 @@ function onMessage(msg) {
       replyOpen = false;
       history.append(userBubble(msg.utterance));
       history.lastElementChild.setAttribute("data-utterance", ""); // addTurn will not repeat it
+      microphone.heard();
       planning.show(msg);
       scrollDown();
       break;
@@ -120,9 +122,10 @@ function onMessage(msg) {
     case "state":
       robot.update(msg);
       planning.update(msg.planning);
+      microphone.serverVoice(msg.voice);
       if (msg.library_version !== libraryVersion) { libraryVersion = msg.library_version; loadMotions(); }
       break;
-    case "error": showError(msg.message); clearPlanning(); break;
+    case "error": showError(msg.message); clearPlanning(); microphone.serverError(msg.message); break;
   }
 }
 
@@ -163,6 +166,7 @@ function showConnection(up) {
   $("connection").classList.toggle("late", !up);
   $("offline").classList.toggle("hidden", up);
   robot.live(up);
+  microphone.connection(up);
   if (up) $("interrupt-note").textContent = "";
 }
 
@@ -194,48 +198,5 @@ $("interrupt").addEventListener("click", () => {
   $("interrupt-note").textContent = sent ? "interrupt sent…" : "not connected: the interrupt was not sent";
 });
 
-// Microphone (only shown when the server has an ASR): record while held, send on release. getUserMedia
-// resolves only after the permission prompt, so a release that comes first stops the take as it starts
-// (otherwise a quick tap would leave the microphone recording).
-let recorder = null;
-let held = false;
-
-async function startRecording() {
-  held = true;
-  try {
-    const stream = await navigator.mediaDevices.getUserMedia({ audio: true });
-    const chunks = [];
-    const take = new MediaRecorder(stream);
-    take.ondataavailable = (e) => chunks.push(e.data);
-    take.onstop = () => {
-      stream.getTracks().forEach((t) => t.stop());
-      sendRecording(new Blob(chunks, { type: take.mimeType.split(";")[0] }));
-    };
-    take.start();
-    recorder = take;
-    $("mic").classList.add("recording");
-    if (!held) stopRecording();
-  } catch (error) { showError(`microphone: ${error.message}`); }
-}
-
-function stopRecording() {
-  held = false;
-  if (recorder && recorder.state === "recording") recorder.stop();
-  recorder = null;
-  $("mic").classList.remove("recording");
-}
-
-// The transcript comes back as an ordinary turn through the WebSocket; only a failure is answered here.
-async function sendRecording(blob) {
-  const response = await fetch("/api/utterance/audio",
-    { method: "POST", body: blob, headers: { "Content-Type": blob.type } });
-  if (!response.ok) {
-    const answer = await response.json().catch(() => ({}));
-    showError(answer.error || `microphone: HTTP ${response.status}`);
-  }
-}
-
-$("mic").addEventListener("pointerdown", startRecording);
-$("mic").addEventListener("pointerdown", () => socket.send({ type: "listening", active: true }));
-$("mic").addEventListener("pointerup", stopRecording);
-$("mic").addEventListener("pointercancel", stopRecording);
+// The microphone (shown when the server has an ASR): streamed over this socket, mic.js.
+const microphone = new Microphone($("mic"), $("mic-state"), (bytes) => socket.sendBytes(bytes));

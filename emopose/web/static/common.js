@@ -82,6 +82,11 @@ export function connect({ message, frame, status }) {
       socket.send(JSON.stringify(msg));
       return true;
     },
+    sendBytes: (buffer) => { // the microphone's PCM frames (mic.js)
+      if (!socket || socket.readyState !== WebSocket.OPEN) return false;
+      socket.send(buffer);
+      return true;
+    },
   };
 }
 
