@@ -12,6 +12,7 @@ import time
 import pytest
 from fastapi.testclient import TestClient
 
+from emopose import CONTROL_DT
 from tests.web.conftest import LOCAL
 
 WS = "ws://127.0.0.1/ws"
@@ -70,9 +71,14 @@ def test_each_cue_learns_where_its_stroke_actually_landed(client):
         return [m for m in log if m["type"] == "cue_stroke" and m["turn_id"] == turn["turn_id"]]
 
     assert wait_for(lambda: len(landed()) == 2, timeout_s=15)
+    # The stroke is stamped at the first 20 ms tick within tolerance of its pose (up to a tick after the
+    # planned crossing), and a timed gesture starts at the first tick after its release, which moves the
+    # crossing by less than another tick; plus whatever the real-time loop reports it was late by on
+    # this (possibly busy) machine.
+    late_s = client.get("/api/status").json()["loop"]["lateness_ms_max"] / 1e3
     for update in landed():
         planned = turn["cues"][update["k"]]["stroke_s"]
-        assert abs(update["executed_s"] - planned) <= 0.03  # one 20 ms tick (+ float noise)
+        assert -CONTROL_DT <= update["executed_s"] - planned <= 2 * CONTROL_DT + late_s
     stored = next(m for m in client.get("/api/turns").json()["log"] if m.get("turn_id") == turn["turn_id"]
                   and m["type"] == "turn")
     assert all(c["stroke_executed_s"] is not None for c in stored["cues"])
