@@ -26,7 +26,9 @@ class ChildProcessGone(RuntimeError):
 class ChildProcess:
     def __init__(self, module: str, function: str, *args: Any, name: str = "child") -> None:
         self.name = name
-        command = f"from {module} import {function}; {function}(*{args!r})"
+        # a real-time parent's scheduling is inherited: the child's work must not compete with the loop
+        command = (f"from emopose.execution.priority import normal_scheduling; normal_scheduling(); "
+                   f"from {module} import {function}; {function}(*{args!r})")
         root = str(Path(__file__).resolve().parents[1])
         paths = filter(None, (root, os.environ.get("PYTHONPATH")))
         env = {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}

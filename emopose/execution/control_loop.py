@@ -10,15 +10,14 @@ With a FakeClock the same loop renders a run as fast as the CPU allows; with Mon
 real time. `run_until()` drives it on the caller's thread; `start()`/`stop()` run it on a background
 thread for the web UI, speech and the tour; `wait_until()` waits the right way for either.
 Served, the loop shares its process with the web server, planning and synthesis (frames and espeak render
-in child processes); `start(rt_priority)` puts its thread in SCHED_FIFO (else at a negative nice, else as
-it was, with one log line), the process's other threads at PROCESS_NICE, and shortens Python's thread
-switch interval, so neither the OS nor the GIL keeps it waiting for long.
+in child processes); `start(rt_priority)` puts its thread in SCHED_FIFO (priority.py: else a negative
+nice, else as it was, with one log line), the process's other threads in SCHED_RR below it, and shortens
+Python's thread switch interval, so neither the OS nor the GIL keeps it waiting for long.
 """
 
 from __future__ import annotations
 
 import logging
-import os
 import sys
 import threading
 import time
@@ -33,56 +32,14 @@ from emopose.backends.base import Backend
 from emopose.clock import Clock
 from emopose.execution.collector import CollectorPauses, freeze_survivors
 from emopose.execution.pacing import DeadlineGrid
+from emopose.execution.priority import normal_scheduling, raise_process_priority, raise_thread_priority
 from emopose.execution.sequencer import Sequencer
 from emopose.execution.worker import Worker
 from emopose.recording import Recorder
 
 log = logging.getLogger(__name__)
 
-FALLBACK_NICE = -10  # where SCHED_FIFO is refused but raising the thread's nice value is allowed
-# The process's other threads (web server, planner, speech) in real-time runs. The loop thread needs the
-# GIL on every tick; a thread holding it that other processes keep off the CPU would hold the loop up for
-# as long (priority inversion through the GIL: 700 ms gaps were seen on an overloaded machine).
-PROCESS_NICE = -5
 RT_SWITCH_INTERVAL_S = 0.0005  # GIL hand-over interval while the loop runs on its thread (Python: 5 ms)
-
-
-def check_rt_priority(priority: int) -> int:
-    """run.rt_priority, checked where a job is configured: the OS would refuse a value outside 1-99 and the
-    loop would fall back unnoticed."""
-    if not 0 <= priority <= 99:
-        raise ValueError(f"run.rt_priority={priority}: a SCHED_FIFO priority is 1-99 (0: normal)")
-    return priority
-
-
-def raise_thread_priority(priority: int) -> str:
-    """Ask the OS to run the calling thread first: SCHED_FIFO at `priority` (1-99), else nice
-    FALLBACK_NICE. Where neither is permitted (no CAP_SYS_NICE, a container, not Linux) the thread keeps
-    its scheduling and one log line says so. Returns what the thread got."""
-    thread = threading.get_native_id()
-    try:
-        os.sched_setscheduler(thread, os.SCHED_FIFO, os.sched_param(priority))
-        return f"SCHED_FIFO {priority}"
-    except (AttributeError, OSError):
-        pass
-    try:
-        os.setpriority(os.PRIO_PROCESS, thread, FALLBACK_NICE)  # Linux: a thread id sets that thread only
-        return f"nice {FALLBACK_NICE}"
-    except (AttributeError, OSError) as exc:
-        log.warning("control loop: real-time priority not permitted (%s); normal scheduling", exc)
-        return "normal"
-
-
-def raise_process_priority(nice: int = PROCESS_NICE) -> str:
-    """Every thread of this process (and those it starts later: they inherit it) at `nice`, so that a
-    thread holding the GIL gets the CPU back before other processes' work. Where not permitted, as it was."""
-    try:
-        for task in os.listdir("/proc/self/task"):  # Linux: nice is per thread
-            os.setpriority(os.PRIO_PROCESS, int(task), nice)
-        return f"process nice {nice}"
-    except (AttributeError, OSError) as exc:
-        log.warning("control loop: raising the process's priority not permitted (%s)", exc)
-        return "process nice unchanged"
 
 
 @dataclass
@@ -234,6 +191,7 @@ class ControlLoop:
         if self._saved_switch_interval is not None:
             sys.setswitchinterval(self._saved_switch_interval)
             self._saved_switch_interval = None
+            normal_scheduling()  # what runs after (a tour's video, say) competes like any other work
 
     @property
     def running(self) -> bool:

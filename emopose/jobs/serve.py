@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 from emopose.build import ConfigError
 from emopose.contract import USABLE_SOURCES
-from emopose.execution.control_loop import check_rt_priority
+from emopose.execution.priority import check_rt_priority
 from emopose.resources import Run
 from emopose.results import JobFailure, JobOutput, markdown_table
 from emopose.web.serve_tally import SOURCE_WORDS

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Protocol
 
 from emopose.backends.base import Backend
-from emopose.execution.control_loop import check_rt_priority
+from emopose.execution.priority import check_rt_priority
 from emopose.library import MotionLibrary
 from emopose.planners.base import Planner
 from emopose.resources import Run

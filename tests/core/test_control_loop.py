@@ -4,8 +4,6 @@ sent as a burst; no two commands closer than half a period; lateness kept in a b
 from __future__ import annotations
 
 import gc
-import logging
-import os
 import sys
 import threading
 
@@ -142,44 +140,6 @@ def test_the_loop_records_what_the_backend_sent_not_what_was_asked(library, rest
 
 
 # -- the loop thread's priority: what the OS permits, and a clean fallback -----------------------------
-def refuse(*_args) -> None:
-    raise PermissionError("Operation not permitted")
-
-
-def test_the_loop_thread_asks_for_sched_fifo_first(monkeypatch):
-    calls = []
-    monkeypatch.setattr(control_loop.os, "sched_setscheduler", lambda *args: calls.append(args))
-    assert control_loop.raise_thread_priority(10) == "SCHED_FIFO 10"
-    (thread, policy, param), = calls
-    assert thread == threading.get_native_id() and policy == os.SCHED_FIFO and param.sched_priority == 10
-
-
-def test_without_sched_fifo_the_thread_is_reniced_and_without_that_left_alone(monkeypatch, caplog):
-    reniced = []
-    monkeypatch.setattr(control_loop.os, "sched_setscheduler", refuse)
-    monkeypatch.setattr(control_loop.os, "setpriority", lambda *args: reniced.append(args))
-    assert control_loop.raise_thread_priority(10) == f"nice {control_loop.FALLBACK_NICE}"
-    assert reniced == [(os.PRIO_PROCESS, threading.get_native_id(), control_loop.FALLBACK_NICE)]
-    monkeypatch.setattr(control_loop.os, "setpriority", refuse)
-    with caplog.at_level(logging.WARNING, logger=control_loop.__name__):
-        assert control_loop.raise_thread_priority(10) == "normal"
-    assert len(caplog.records) == 1 and "not permitted" in caplog.records[0].getMessage()
-
-
-def test_every_thread_of_the_process_is_reniced_or_left_alone(monkeypatch, caplog):
-    """The GIL's holder must not wait behind other processes: every thread gets PROCESS_NICE."""
-    reniced = []
-    monkeypatch.setattr(control_loop.os, "setpriority", lambda *args: reniced.append(args))
-    assert control_loop.raise_process_priority() == f"process nice {control_loop.PROCESS_NICE}"
-    threads = {int(task) for task in os.listdir("/proc/self/task")}
-    assert {tid for _, tid, _ in reniced} == threads and threading.get_native_id() in threads
-    assert {(kind, nice) for kind, _, nice in reniced} == {(os.PRIO_PROCESS, control_loop.PROCESS_NICE)}
-    monkeypatch.setattr(control_loop.os, "setpriority", refuse)
-    with caplog.at_level(logging.WARNING, logger=control_loop.__name__):
-        assert control_loop.raise_process_priority() == "process nice unchanged"
-    assert "not permitted" in caplog.records[0].getMessage()
-
-
 @pytest.mark.parametrize("priority, expected", [(10, "SCHED_FIFO 10; process nice -5"), (0, "normal")])
 def test_start_raises_the_thread_and_shortens_the_switch_interval_until_stop(make_loop, monkeypatch,
                                                                              priority, expected):

@@ -12,8 +12,12 @@ from collections import Counter
 from pathlib import Path
 
 import pytest
+import yaml
 
+from emopose.contract import LibraryEntry
 from emopose.planners.base import PlanRequest
+from emopose.planners.local.direction import added_ways, off_way
+from emopose.planners.local.probes import probe_moves
 from tests.planners.local_helpers import configured_local_planner
 
 NEW = Path(__file__).parent / "new_motions"
@@ -65,3 +69,32 @@ def test_new_motions_cost_the_reading_of_other_utterances_little(tmp_path):
     after = held_out_metrics(planner, examples, scored)
     assert after["single_top1"] >= before["single_top1"] - 0.02, (before, after)
     assert after["sequence_exact"] >= before["sequence_exact"] - 0.02, (before, after)
+
+
+MAPPING = {"left": "point_left", "up": "point_up", "down": "point_forward_right",
+           "there": "point_forward_right"}
+
+
+def test_an_added_pointing_motion_points_the_way_its_description_names():
+    evidence = {"point_down": ("pointing", ("point down: Right arm points straight down at the floor",)),
+                "point_with_flair": ("pointing", ("point with flair: a showy flourish of the hand",)),
+                "point_up": ("pointing", ("point up: Right arm rises to point straight up",)),
+                "finger_wag": ("rejecting", ("finger wag: wagged side to side, down low",))}
+    ways = added_ways(evidence, MAPPING)
+    assert ways == {"point_down": "down"}  # mapped, naming no way, or not pointing: the choice alone decides
+    assert off_way("Mind the step down here at your feet.", ways) == frozenset()
+    assert off_way("Tickets are sold at the main entrance.", ways) == {"point_down"}  # names no way
+    assert off_way("Check the board above the platform.", ways) == {"point_down"}  # names another
+
+
+# Before the rule (direction.py's off_way), point_down took the neutral probe "Tickets are sold at the main
+# entrance." (read as pointing by the class head, as the training data reads a place named for the
+# listener) from point_forward_right, and "Check the board above the platform ..." (held-out) from point_up,
+# on place words that sound like its "floor" and "ground".
+@pytest.mark.slow
+def test_an_added_pointing_motion_takes_only_acts_that_name_its_way(planner):
+    point_down = LibraryEntry.model_validate(yaml.safe_load((NEW / "point_down.yaml").read_text()))
+    assert not [m for m in probe_moves(planner, point_down) if m.intent != "pointing"]
+    add_new_motions(planner)
+    plan = planner.plan(PlanRequest("Check the board above the platform for the next train."))
+    assert [g["variant"] for g in json.loads(plan.raw)["gestures"]] == ["point_up"]

@@ -104,6 +104,19 @@ def test_a_class_without_motions_or_a_neighbours_class_is_never_moved_to(chooser
                           frozenset({"rejecting"}))[0] == "doubting"
 
 
+def test_a_barred_motion_is_never_chosen_in_the_class_or_across(chooser):
+    # the planner bars an added pointing motion aimed a way the act does not name (direction.py)
+    unsure = proba(doubting=0.6, rejecting=0.4)
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", unsure, act_near("shrug"), STAY,
+                          barred=frozenset({"shrug"})) == ("doubting", "chin_stroke")
+    # the best fit of the other class is barred: its runner-up (fitting no better than chin_stroke) is no move
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", unsure, act_near("finger_wag"), MOVE,
+                          barred=frozenset({"finger_wag"})) == ("doubting", "chin_stroke")
+    # every motion of the act's class barred: the class stays, without a motion, and nothing moves it
+    assert chooser.choose(lambda: EVIDENCE, 1, "doubting", unsure, act_near("finger_wag"), MOVE,
+                          barred=frozenset({"shrug", "chin_stroke"})) == ("doubting", None)
+
+
 def test_a_rare_word_the_description_also_says_decides_between_motions():
     # token ids: 7 "naughty" (rare), 1 "the" (frequent); only finger_wag's description says "naughty"
     words = {"finger_wag": (np.array([7, 1]), np.array([0.9, 0.01])),

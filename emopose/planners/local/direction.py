@@ -5,8 +5,12 @@ A pointing act's trigger and its whole text are searched for a direction, strong
 speaker (me, myself: "follow me" is rarer in a pointing act than "over there"). A side counts only where
 the word names one ("on your left", "turn right", "the left-hand door"), not in "right there" or "I left
 it". The direction's motion comes from planner.pointing_directions and must be a pointing motion of the
-live library (else the chosen motion stays). It replaces only a motion the mapping names: a pointing
-motion added by file ("point_down") that the variant choice found to fit the words best is kept.
+live library (else the chosen motion stays). It replaces only a motion the mapping names. A pointing
+motion added by file points the way its description names ("point down: ... at the floor": down;
+added_ways); the variant choice may give it only an act whose words name that way (off_way): its fit
+to an act that names no direction comes from place words that merely sound alike ("main entrance" and
+"the floor"), not from the way the act points. An added motion whose description names no direction is
+chosen by its fit alone, and so kept.
 
 Perspective (planner.pointing_frame): left and right name the robot's own sides. In the `shared` frame
 (default) the robot shows the way standing beside its listener, both facing the place, so "your left",
@@ -66,3 +70,20 @@ def pointing_motion(texts: tuple[str, ...], motions: dict[str, str], pointing: f
         return None
     motion = motions.get(min(found)[0][1])
     return motion if motion in pointing else None
+
+
+def added_ways(evidence: dict[str, tuple[str, tuple[str, ...]]], motions: dict[str, str],
+               frame: Frame = "shared") -> dict[str, str]:
+    """Pointing motions outside the mapping (added by file) -> the way their description names (those
+    naming none left out). evidence: name -> (class, (description text, *examples)), the live library's;
+    motions: direction -> name, the mapping."""
+    mapped = set(motions.values())
+    ways = {name: direction_of(texts[0], frame) for name, (cls, texts) in evidence.items()
+            if cls == "pointing" and name not in mapped}
+    return {name: way for name, way in ways.items() if way is not None}
+
+
+def off_way(text: str, ways: dict[str, str], frame: Frame = "shared") -> frozenset[str]:
+    """The added pointing motions (ways: added_ways()) that point a way the act's text does not name."""
+    named = direction_of(text, frame)
+    return frozenset(name for name, way in ways.items() if way != named)

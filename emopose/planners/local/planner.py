@@ -44,7 +44,7 @@ from emopose.planners.local.artifact import (
 )
 from emopose.planners.local.catalogue import motion_catalogue, motion_evidence
 from emopose.planners.local.config import LocalSettings
-from emopose.planners.local.direction import pointing_motion
+from emopose.planners.local.direction import added_ways, off_way, pointing_motion
 from emopose.planners.local.heads import Analysis
 from emopose.planners.local.inference import LocalInference
 from emopose.planners.local.segment import Segment, segments
@@ -208,18 +208,20 @@ class LocalPlanner:
         train_local. Each act's motion is chosen with its class (planners/local/variants.py): a motion
         of another class that fits the act's words better than its own class's may move it
         (variant_class_weight, and variant_class_weight_new for a motion the training data never
-        annotated)."""
+        annotated); a pointing motion added by file only when the act names its way (direction.py)."""
         pieces, spans = scored.pieces, scored.spans
         openings = self.boundary_weight * scored.boundaries - self.act_cost
         split = semi_crf.best_split(len(pieces), spans, scored.logits / self.temperature, openings)
         acts: list[_Act] = []
+        ways = added_ways(self._evidence(), self.settings.pointing_directions, self.settings.pointing_frame)
         for n, (k, c) in enumerate(split):
             proba = softmax(scored.logits[k])
             neighbours = {acts[-1].cls} if acts else set()  # neighbouring acts keep differing in class
             neighbours |= {CLASSES[split[n + 1][1]]} if n + 1 < len(split) else set()
+            words = " ".join(piece.text for piece in pieces[spans[k][0]:spans[k][1]])
             cls, variant = self.variants.choose(self._evidence, self.library.version, CLASSES[c], proba,
-                                                scored.features[k], self.class_move,
-                                                frozenset(neighbours))
+                                                scored.features[k], self.class_move, frozenset(neighbours),
+                                                off_way(words, ways, self.settings.pointing_frame))
             acts.append(_Act(pieces[spans[k][0]].start, pieces[spans[k][1] - 1].end, cls, proba, variant))
         return acts
 

@@ -168,8 +168,8 @@ class VariantChooser:
         self._cached: tuple = (-1, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool), ())
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, tuple[str, ...]]]], version: int, cls: str,
-               proba: np.ndarray, act: Features, move: ClassMove,
-               excluded: frozenset[str] = frozenset()) -> tuple[str, str | None]:
+               proba: np.ndarray, act: Features, move: ClassMove, excluded: frozenset[str] = frozenset(),
+               barred: frozenset[str] = frozenset()) -> tuple[str, str | None]:
         """(class, motion) for an act the split model reads as cls with class probabilities proba.
         Within cls the best-scoring motion is chosen. Another class c moves the act when its best motion
         m fits by enough more: log proba[c] + w(m) * (score(m) - score of cls's best) > log proba[cls].
@@ -177,7 +177,9 @@ class VariantChooser:
         saw: the class head's probabilities already weigh what the data says of a known motion's uses,
         while for a new one (a "finger wag" added by file, for a scolding the model read as comforting)
         the fit is all there is. A weight of 0 never moves; nor does anything when cls has no motion.
-        Classes in excluded (the neighbouring acts') are never moved to. catalogue() -> the live
+        Classes in excluded (the neighbouring acts') are never moved to; motions in barred are never
+        chosen (an added pointing motion aimed a way the act does not name: the planner's rule,
+        planners/local/direction.py), a class whose motions all are has none. catalogue() -> the live
         library's selectable motions, name -> (class, (description text, *example utterances)), read
         again when the library's version changes; a motion scores as its best-fitting text. act: the
         act's Features (one row)."""
@@ -196,7 +198,8 @@ class VariantChooser:
             cached = self._cached = (version, list(entries), classes, is_annotated, (motions, owner))
         _, names, classes, is_annotated, (motions, owner) = cached
         own = CLASSES.index(cls)
-        members = np.flatnonzero(classes == own)
+        selectable = np.array([name not in barred for name in names], dtype=bool)
+        members = np.flatnonzero((classes == own) & selectable)
         if not len(members):
             return cls, None
         row = np.full(len(names), -np.inf)
@@ -205,8 +208,8 @@ class VariantChooser:
         own_best = members[int(np.argmax(row[members]))]
         chosen, best_total = own_best, np.log(proba[own] + 1e-12)
         weight = np.where(is_annotated, move.annotated, move.new)
-        for other in sorted(set(classes.tolist()) - {own} - {CLASSES.index(c) for c in excluded}):
-            members = np.flatnonzero(classes == other)
+        for other in sorted(set(classes[selectable].tolist()) - {own} - {CLASSES.index(c) for c in excluded}):
+            members = np.flatnonzero((classes == other) & selectable)
             m = members[int(np.argmax(row[members]))]
             if not weight[m]:
                 continue  # no weight, no move (the split may have chosen a less likely class for a reason)
