@@ -150,6 +150,10 @@ class Utterances:
         if not self.vad.speaking and len(self._pcm) > keep:
             self._drop(len(self._pcm) - keep)
 
+    def pending(self) -> bytes:
+        """The utterance so far, as it would be written if the VAD ended it now (early_asr.py)."""
+        return self._pcm[:self._byte_at(self.vad.last_speech_end_s)]
+
     def _byte_at(self, t_s: float) -> int:
         return max(0, 2 * round((t_s - self._offset_s) * SAMPLE_RATE))
 

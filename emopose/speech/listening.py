@@ -17,6 +17,7 @@ from pathlib import Path
 
 from emopose.speech.audio_in import SAMPLE_RATE, wav_pcm16
 from emopose.speech.barge_in import BargeIn
+from emopose.speech.echo import EchoGate
 from emopose.speech.g1_microphone import MIC_GROUP, MIC_PORT
 
 AUDIO_SOURCES = ("page", "g1")
@@ -32,6 +33,9 @@ class ListeningSettings:
     speaking_threshold: float = 0.8
     speaking_min_speech_ms: float = 160.0
     echo_return_loss_db: float = 6.0
+    echo_margin_db: float = 10.0
+    double_talk_min_speech_ms: float = 96.0
+    early_transcribe_ms: float | None = None  # a pause this long starts transcribing (None: at VAD end)
     mic_group: str | None = MIC_GROUP   # audio_source=g1: the robot's multicast group (null: plain UDP)
     mic_port: int = MIC_PORT
     mic_interface_ip: str = "0.0.0.0"   # our address on the robot's network
@@ -49,12 +53,16 @@ class ListeningSettings:
             raise ValueError(f"asr.listening: unknown setting(s) {sorted(unknown)}")
         return cls(**values)
 
-    def detector(self, detector: Callable[[bytes], float] | None = None) -> BargeIn:
-        """A BargeIn with these settings (its on_barge_in is set by whoever reacts: turn/listening.py)."""
+    def detector(self, detector: Callable[[bytes], float] | None = None,
+                 echo: EchoGate | None = None) -> BargeIn:
+        """A BargeIn with these settings (its on_barge_in is set by whoever reacts: turn/listening.py);
+        `echo`: the room a previous one learned (speech/echo.py)."""
         return BargeIn(on_barge_in=lambda t: None, threshold=self.threshold,
                        speaking_threshold=self.speaking_threshold, min_speech_ms=self.min_speech_ms,
                        speaking_min_speech_ms=self.speaking_min_speech_ms, hang_ms=self.hang_ms,
-                       echo_return_loss_db=self.echo_return_loss_db, detector=detector)
+                       echo_return_loss_db=self.echo_return_loss_db, echo_margin_db=self.echo_margin_db,
+                       double_talk_min_speech_ms=self.double_talk_min_speech_ms, detector=detector,
+                       echo=echo)
 
 
 class PlaybackReference:

@@ -66,23 +66,37 @@ class VoiceActivity:
         """Stream time consumed so far (whole chunks)."""
         return self._chunks_seen * CHUNK_S
 
+    @property
+    def pause_s(self) -> float:
+        """Inside speech: the silence heard since its last speech chunk (its turn may be ending); else 0."""
+        return self._run * CHUNK_S if self.speaking else 0.0
+
+    @property
+    def last_speech_end_s(self) -> float:
+        """Stream time where the last speech chunk ended (an end event reports this instant)."""
+        return self._last_speech_end
+
     def feed(self, pcm: bytes) -> list[SpeechEvent]:
         events = []
-        for t_s, _, probability in self.scored(pcm):
+        for t_s, probability, _ in self.scored(pcm):
             event = self.update(t_s, self.is_speech(probability))
             if event is not None:
                 events.append(event)
         return events
 
-    def scored(self, pcm: bytes) -> Iterator[tuple[float, bytes, float]]:
-        """(chunk start time, chunk, speech probability) for every whole chunk now available."""
+    def scored(self, pcm: bytes) -> Iterator[tuple[float, float, bytes]]:
+        """(chunk start time, speech probability, chunk) for every whole chunk now available."""
         self._buffer += pcm
         while len(self._buffer) >= CHUNK_BYTES:
             chunk, self._buffer = self._buffer[:CHUNK_BYTES], self._buffer[CHUNK_BYTES:]
-            t_s = self.t_s
-            self._chunks_seen += 1
-            self.last_probability = float(self.detector(chunk))
-            yield t_s, chunk, self.last_probability
+            yield self.score(chunk) + (chunk,)
+
+    def score(self, chunk: bytes) -> tuple[float, float]:
+        """(start time, speech probability) of one whole chunk (a caller that buffers itself: BargeIn)."""
+        t_s = self.t_s
+        self._chunks_seen += 1
+        self.last_probability = float(self.detector(chunk))
+        return t_s, self.last_probability
 
     def is_speech(self, probability: float, threshold: float | None = None) -> bool:
         base = self.threshold if threshold is None else threshold

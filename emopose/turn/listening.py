@@ -11,8 +11,9 @@ reference, and passes the speech events on to `utterances`, which hands each fin
 end after the hang time) on as a WAV. A barge-in calls `silence` once (the runner's silence(): the
 reply stops streaming, the player stops, on player=g1 with stop play 1004, the sequencer is
 interrupted and the arms blend to rest) and records when, on the caller's clock, in `barge_ins`.
-Stream time maps to clock time from the first feed on (`at` gives a feed's clock time explicitly:
-a job feeding recorded audio on virtual time).
+With `early` (speech/early_asr.py), a pause in the visitor's speech starts transcribing it, so at the
+VAD end `early.transcript(path)` is mostly ready. Stream time maps to clock time from the first feed on
+(`at` gives a feed's clock time explicitly: a job feeding recorded audio on virtual time).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from dataclasses import dataclass
 from emopose.clock import Clock
 from emopose.speech.audio_in import SAMPLE_RATE
 from emopose.speech.barge_in import BargeIn
+from emopose.speech.early_asr import EarlyTranscripts
 from emopose.speech.g1_microphone import Utterances
 from emopose.speech.vad import SpeechEvent
 
@@ -40,9 +42,10 @@ class BargeInRecord:
 class Listener:
     def __init__(self, barge: BargeIn, clock: Clock, speaking: Callable[[], bool],
                  silence: Callable[[], None], utterances: Utterances | None = None,
-                 reference: Callable[[float, int], bytes | None] | None = None) -> None:
+                 reference: Callable[[float, int], bytes | None] | None = None,
+                 early: EarlyTranscripts | None = None) -> None:
         self.barge, self.clock, self.speaking, self.silence = barge, clock, speaking, silence
-        self.utterances, self.reference = utterances, reference
+        self.utterances, self.reference, self.early = utterances, reference, early
         barge.on_barge_in = self._barge_in
         self.barge_ins: list[BargeInRecord] = []
         self._robot = False
@@ -76,6 +79,8 @@ class Listener:
             events = self.barge.feed(pcm, reference)
             if self.utterances is not None:
                 self.utterances.take(pcm, events)
+                if self.early is not None:
+                    self.early.consider(self.barge.vad, self.utterances)
             return events
 
     def _barge_in(self, onset_stream_s: float) -> None:

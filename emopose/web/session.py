@@ -157,7 +157,7 @@ class LiveSession:
 
     def _say_heard(self, audio_path: Path) -> None:
         try:
-            text = self.res.asr.utterance(audio=audio_path)
+            text = self.voice.transcript(audio_path)
             if text:
                 self._say(text, None)
         except Exception as exc:  # noqa: BLE001 - no page waits on this turn: every page hears why

@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 
 from emopose.execution.posture import LISTENING, REST
+from emopose.speech.early_asr import EarlyTranscripts
 from emopose.speech.g1_microphone import RobotMicrophone, Utterances
 from emopose.speech.listening import ListeningSettings, PlaybackReference
 from emopose.turn.listening import Listener
@@ -32,6 +33,7 @@ class VoiceIO:
         self.microphone: RobotMicrophone | None = None
         self.light: StateLight | None = chest_light(session)
         self.posture = res.sequencer.posture
+        self.asr = res.asr
         if session.hears_speech:
             settings = ListeningSettings.from_config(res.asr.listening)
             self.listener = listener_for(session, settings)
@@ -48,6 +50,11 @@ class VoiceIO:
             self.posture.request(LISTENING if event.kind == "start" else REST)
         return True
 
+    def transcript(self, audio_path) -> str:
+        """An utterance the VAD ended, transcribed (mostly during the hang time already: early_asr.py)."""
+        early = self.listener.early if self.listener is not None else None
+        return early.transcript(audio_path) if early else self.asr.utterance(audio=audio_path)
+
     def state(self) -> dict | None:
         """For the page (state.voice): whether the VAD hears the visitor now, and how many utterances it
         has ended (each is transcribed, then said: its turn_started message carries the transcript)."""
@@ -57,6 +64,8 @@ class VoiceIO:
         return {"speaking": self.listener.visitor_speaking, "utterances": ended}
 
     def close(self) -> None:
+        if self.listener is not None and self.listener.early is not None:
+            self.listener.early.close()
         if self.microphone is not None:
             self.microphone.stop()
         if self.light is not None:
@@ -71,7 +80,10 @@ def listener_for(session, settings: ListeningSettings) -> Listener:
     utterances = Utterances(barge.vad, session.run.session.run_dir / "heard", session.say_heard)
     reference = PlaybackReference(res.player) if settings.audio_source == "g1" else None
     silence = session.interrupt if settings.barge_in else (lambda: None)
-    return Listener(barge, res.clock, lambda: res.player.playing(res.clock), silence, utterances, reference)
+    early = None if settings.early_transcribe_ms is None else EarlyTranscripts(
+        res.asr, session.run.session.run_dir / "heard" / "early", settings.early_transcribe_ms)
+    return Listener(barge, res.clock, lambda: res.player.playing(res.clock), silence, utterances, reference,
+                    early)
 
 
 def chest_light(session) -> StateLight | None:
