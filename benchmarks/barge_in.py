@@ -87,21 +87,23 @@ def trial(run, settings, echo, reply_text, visitor_pcm, at_s, out_dir, echo_db) 
         out["stop_ms"] = 1000 * (listener.barge_ins[0].stopped_s - voice_at)
         out["interrupted"] = not res.sequencer.pending and not res.player.playing(res.clock)
     if heard:
-        out.update(answer_after_vad_end(run, early, heard[0], vad_end))
+        out.update(answer_after_vad_end(run, early, heard[0], vad_end, settings.reply_preroll_s))
     if early is not None:
         early.close()
     return out
 
 
-def answer_after_vad_end(run, early, utterance, vad_end) -> dict:
-    """VAD end -> the answer's first audio, with each stage's share (ms)."""
+def answer_after_vad_end(run, early, utterance, vad_end, preroll_at_most) -> dict:
+    """VAD end -> the answer's first audio, with each stage's share (ms); a spoken reply's pre-roll is
+    bounded as the serve bounds it (asr.listening.reply_preroll_s)."""
     text = early.transcript(utterance) if early else run.resources.asr.utterance(audio=utterance)
     transcribed = time.monotonic()
-    answer = run.runner.run(text or "Pardon?")
+    answer = run.runner.run(text or "Pardon?", preroll_at_most=preroll_at_most)
     run.runner.silence()
     return {"first_audio_ms": 1000 * (answer.dispatched.speech_start - vad_end),
             "asr_wait_ms": 1000 * (transcribed - vad_end), "early_transcript": bool(early and early.used),
             "stage_ms": {k: round(1000 * v, 1) for k, v in answer.stage_s.items()},
+            "preroll_ms": 1000 * answer.schedule.preroll_s,
             "outside_stages_ms": 1000 * (answer.dispatched.speech_start - transcribed)
             - sum(1000 * v for v in answer.stage_s.values()),  # the pre-roll is inside dispatch
             "transcript": text}

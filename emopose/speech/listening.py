@@ -36,11 +36,17 @@ class ListeningSettings:
     echo_margin_db: float = 10.0
     double_talk_min_speech_ms: float = 96.0
     early_transcribe_ms: float | None = None  # a pause this long starts transcribing (None: at VAD end)
+    # A spoken reply's speech waits at most this long for its first gesture's preparation (the timeline's
+    # pre-roll, 0.4 s for typed input): the visitor has already waited through the hang time and the
+    # transcription. A first gesture that needs longer is softened or comes late (stages/softening.py).
+    reply_preroll_s: float = 0.2
     mic_group: str | None = MIC_GROUP   # audio_source=g1: the robot's multicast group (null: plain UDP)
     mic_port: int = MIC_PORT
     mic_interface_ip: str = "0.0.0.0"   # our address on the robot's network
 
     def __post_init__(self) -> None:
+        if self.reply_preroll_s < 0:
+            raise ValueError(f"asr.listening.reply_preroll_s must be >= 0, got {self.reply_preroll_s}")
         if self.audio_source not in AUDIO_SOURCES:
             raise ValueError(f"asr.listening.audio_source must be one of {AUDIO_SOURCES}, "
                              f"got {self.audio_source!r}")

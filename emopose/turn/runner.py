@@ -58,17 +58,20 @@ class TurnRunner:
         return replace(self, pipeline=pipeline)
 
     def run(self, utterance: str, image: str | bytes | None = None, *, planner: Planner | None = None,
-            question: str | None = None, remember: bool = True) -> Turn:
+            question: str | None = None, remember: bool = True, preroll_at_most: float | None = None) -> Turn:
         """Plan and execute one utterance through the whole pipeline; it joins the dialogue as an exchange.
 
         `planner` replaces the configured one for this turn (the tour answers visitors with a sibling);
         `question` and `remember=False` are the tour's, which says prepared lines and adds to the dialogue
-        what was actually said (Dialogue.request, Dialogue.said)."""
+        what was actually said (Dialogue.request, Dialogue.said). `preroll_at_most` bounds the timeline's
+        pre-roll for a reply the person has already waited for (a spoken one: asr.listening)."""
         self.session.open()
         turn = Turn(self.dialogue.request(utterance, image, question))
         self._record(turn, "request")
         self.plan(turn, planner or self.planner)
-        self._recorded.run(turn)
+        pipeline = self._recorded if preroll_at_most is None else self._recorded.reconfigured(
+            schedule=lambda stage: stage.with_preroll_at_most(preroll_at_most))
+        pipeline.run(turn)
         if remember:
             self.dialogue.exchange(utterance, turn.plan.reply)
         return turn
@@ -93,11 +96,13 @@ class TurnRunner:
         return isinstance(self.planner, StreamingPlanner) and self.planner.streams
 
     def respond(self, utterance: str, image: str | bytes | None = None,
-                on_turn: Callable[[Turn], None] | None = None) -> StreamedReply:
-        """One reply to a person: sentence by sentence when the planner streams, else one turn."""
+                on_turn: Callable[[Turn], None] | None = None,
+                preroll_at_most: float | None = None) -> StreamedReply:
+        """One reply to a person: sentence by sentence when the planner streams (its first sentence's
+        pre-roll bounded by the planner's stream_preroll_s), else one turn (see run())."""
         if self.streams:
             return self.run_streamed(utterance, image, on_turn)
-        turn = self.run(utterance, image)
+        turn = self.run(utterance, image, preroll_at_most=preroll_at_most)
         if on_turn is not None:
             on_turn(turn)
         return StreamedReply([turn])

@@ -93,7 +93,7 @@ class LiveSession:
     async def _on_worker(self, fn, *args) -> dict:
         return await asyncio.get_running_loop().run_in_executor(self._worker, fn, *args)
 
-    def _say(self, text: str, image: bytes | None) -> dict:
+    def _say(self, text: str, image: bytes | None, preroll_at_most: float | None = None) -> dict:
         started = self.pending.begin(lambda: self.publish({"type": "turn_started", "utterance": text}))
         published: list[dict] = []
 
@@ -102,7 +102,7 @@ class LiveSession:
             self.pending.end(started)
 
         try:
-            reply = self.run.runner.respond(text, image, on_turn)
+            reply = self.run.runner.respond(text, image, on_turn, preroll_at_most)
         except PlanningCancelled:
             reply = StreamedReply([], cancelled=True)
         finally:
@@ -159,7 +159,7 @@ class LiveSession:
         try:
             text = self.voice.transcript(audio_path)
             if text:
-                self._say(text, None)
+                self._say(text, None, self.voice.reply_preroll_s)
         except Exception as exc:  # noqa: BLE001 - no page waits on this turn: every page hears why
             problem = f"spoken turn failed: {type(exc).__name__}: {exc}"
             self.publish({"type": "error", "message": problem[:300]})

@@ -34,8 +34,10 @@ class VoiceIO:
         self.light: StateLight | None = chest_light(session)
         self.posture = res.sequencer.posture
         self.asr = res.asr
+        self.reply_preroll_s: float | None = None  # a spoken reply's pre-roll bound (asr.listening)
         if session.hears_speech:
             settings = ListeningSettings.from_config(res.asr.listening)
+            self.reply_preroll_s = settings.reply_preroll_s
             self.listener = listener_for(session, settings)
             if settings.audio_source == "g1":
                 self.microphone = RobotMicrophone(self.hear, settings.mic_group, settings.mic_port,

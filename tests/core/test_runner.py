@@ -1,5 +1,8 @@
+import pytest
+
 from emopose.contract import GestureRecord, Plan
 from emopose.execution.sequencer import State
+from emopose.speech.listening import ListeningSettings
 from tests.wiring import wire
 
 
@@ -51,3 +54,19 @@ def test_the_session_opens_once_whoever_asks(wired):
     loop = wired.session.open()
     wired.runner.run("Hi.")
     assert wired.session.open() is loop and wired.session.is_open
+
+
+def test_a_reply_the_person_waited_for_already_bounds_its_pre_roll(g1, tmp_path):
+    """A spoken reply (asr.listening.reply_preroll_s): the words wait less for the first gesture, which
+    still runs (softened, or late), never dropped for it."""
+    wired = wire(g1, tmp_path, mode="timeline")
+    with wired.session:
+        typed = wired.runner.run("Welcome! The robot arm is over there.")
+        spoken = wired.runner.run("Welcome! The robot arm is over there.", preroll_at_most=0.1)
+    assert typed.schedule.preroll_s > 0.3 and spoken.schedule.preroll_s <= 0.1 + 1e-9
+    assert [r.dropped for r in spoken.schedule.releases] == [None, None]
+
+
+def test_a_negative_spoken_pre_roll_is_refused():
+    with pytest.raises(ValueError, match="reply_preroll_s"):
+        ListeningSettings(reply_preroll_s=-0.1)
