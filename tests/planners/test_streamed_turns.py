@@ -25,8 +25,10 @@ FIRST = len(tokens(SENTENCES[0])) + 1  # the next token's leading space shows th
 
 @pytest.fixture
 def wired(writable_library, make_chat, tmp_path):
+    # the first streamed call in a process loads litellm's streaming parts: seconds on a loaded machine,
+    # which the 5 s deadline of the other planner tests would count against the answer
     planner = make_chat(AnnotatePlanner, "prompts/annotate.md", annotator=KeywordPlanner(), stream=True,
-                        cache=False, max_retries=0, max_sentences=len(SENTENCES))
+                        cache=False, max_retries=0, max_sentences=len(SENTENCES), timeout_s=30.0)
     built = wire(writable_library, tmp_path / "run", planner=planner, mode="timeline")
     with built.session:
         yield built
