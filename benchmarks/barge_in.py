@@ -4,10 +4,11 @@
 
 Each trial: the robot says a line (planner=local, tts=espeak, player=none: the timed sink, so playing()
 and stop() behave as on a device); the microphone, fed in real time in 32 ms chunks, hears the reply's
-echo through a room (tests/speech/room.py: a loudspeaker that compresses peaks, 30 ms delay, a 100 ms
-response of decaying reflections, -12 dB in all by default, microphone noise at -65 dBFS; --echo-db
-changes the level) and a visitor's line (another espeak voice) from a random time in the reply. One
-echo model (speech/echo.py) serves all trials, as in a serve session: it learns the room on the first
+echo while the robot's speaker plays (it stops at a barge-in) through a room (tests/speech/room.py: a
+loudspeaker that compresses peaks, 30 ms delay, a 100 ms response of decaying reflections, -12 dB in all
+by default, microphone noise at -65 dBFS; --echo-db changes the level) and a visitor's line (another
+espeak voice) from a random time in the reply. One echo model (speech/echo.py) serves all trials, as in
+a serve session: it learns the room on the first
 replies. Measured per trial: visitor voice start -> robot audio stopped and sequencer interrupted (the
 clock after runner.silence() returned), and VAD end -> the robot's first audio of the answer, split
 into its stages: the transcript (whisper tiny.en, started early in the hang time: speech/early_asr.py;
@@ -38,7 +39,7 @@ from emopose.speech.echo import EchoGate  # noqa: E402
 from emopose.speech.espeak import EspeakSynthesizer  # noqa: E402
 from emopose.speech.g1_microphone import Utterances  # noqa: E402
 from emopose.speech.listening import ListeningSettings, PlaybackReference  # noqa: E402
-from emopose.speech.vad import CHUNK_BYTES, CHUNK_S, CHUNK_SAMPLES, speech_spans  # noqa: E402
+from emopose.speech.vad import CHUNK_S, CHUNK_SAMPLES, speech_spans  # noqa: E402
 from emopose.turn.listening import Listener  # noqa: E402
 from tests.conftest import compose_config  # noqa: E402
 from tests.speech.room import room_echo  # noqa: E402
@@ -52,31 +53,40 @@ VISITOR = ["Excuse me, where are the toilets?", "Wait, can you show me the garde
            "Sorry, what is that statue made of?", "Could you point to the exit please?"]
 
 
-def microphone(reply: bytes, visitor: bytes, at_s: float, echo_db: float) -> bytes:
-    """The reply's echo through the room, the visitor from at_s, then 1.5 s of quiet for the hang time."""
+def microphone(reply: bytes, visitor: bytes, at_s: float, echo_db: float) -> tuple[np.ndarray, np.ndarray]:
+    """(the reply's echo through the room, the visitor from at_s), both padded by 1.5 s of quiet for the
+    hang time: the trial adds the echo only while the robot's speaker plays (it stops at a barge-in)."""
     echo = room_echo(reply, echo_db)
     voice = np.frombuffer(visitor, "<i2").astype(np.float64)
     at = round(at_s * SAMPLE_RATE)
-    out = np.zeros(max(len(echo), at + len(voice)) + round(1.5 * SAMPLE_RATE))
-    out[:len(echo)] += echo
-    out[at:at + len(voice)] += voice
-    return np.clip(out, -32768, 32767).astype("<i2").tobytes()
+    length = max(len(echo), at + len(voice)) + round(1.5 * SAMPLE_RATE)
+    echo_track, voice_track = np.zeros(length), np.zeros(length)
+    echo_track[:len(echo)] = echo
+    voice_track[at:at + len(voice)] = voice
+    return echo_track, voice_track
+
+
+def heard_chunk(echo: np.ndarray, voice: np.ndarray, k: int, playing: bool) -> bytes:
+    span = slice(k * CHUNK_SAMPLES, (k + 1) * CHUNK_SAMPLES)
+    mixed = voice[span] + (echo[span] if playing else 0.0)
+    return np.clip(mixed, -32768, 32767).astype("<i2").tobytes()
 
 
 def trial(run, settings, echo, reply_text, visitor_pcm, at_s, out_dir, echo_db) -> dict:
     res, heard = run.resources, []
     turn = run.runner.run(reply_text)
     start = turn.dispatched.speech_start
-    mic = microphone(wav_pcm16(turn.speech.audio_path), visitor_pcm or b"", at_s, echo_db)
+    echo_track, voice_track = microphone(wav_pcm16(turn.speech.audio_path), visitor_pcm or b"", at_s, echo_db)
     barge = settings.detector(echo=echo)  # the room learned so far: one per microphone and loudspeaker
     early = None if settings.early_transcribe_ms is None else EarlyTranscripts(
         res.asr, out_dir / "early", settings.early_transcribe_ms)
     listener = Listener(barge, res.clock, lambda: res.player.playing(res.clock), run.runner.silence,
                         Utterances(barge.vad, out_dir, heard.append), PlaybackReference(res.player), early)
     vad_end = None
-    for k in range(len(mic) // CHUNK_BYTES):
+    for k in range(len(voice_track) // CHUNK_SAMPLES):
         res.clock.sleep_until(start + (k + 1) * CHUNK_S)  # the chunk has been heard by now
-        listener.feed(mic[k * CHUNK_BYTES:(k + 1) * CHUNK_BYTES], at=start + k * CHUNK_S)
+        playing = res.player.playing(res.clock)
+        listener.feed(heard_chunk(echo_track, voice_track, k, playing), at=start + k * CHUNK_S)
         if heard:
             vad_end = time.monotonic()
             break
