@@ -52,8 +52,8 @@ class EarlyTranscripts:
             for stale in self._guesses.values():
                 stale.cancel()   # a queued guess for speech that went on; a running one just finishes
             self.started += 1
-            path = write_wav(self.folder / f"early-{self.started:04d}.wav", pcm, SAMPLE_RATE)
-            self._guesses = {key: self._worker.submit(self.recognizer.utterance, audio=path)}
+            path = self.folder / f"early-{self.started:04d}.wav"
+            self._guesses = {key: self._worker.submit(self._transcribe, path, pcm)}
 
     def transcript(self, path: str | Path) -> str:
         """The utterance's transcript: the early one when it was made from these very samples."""
@@ -65,6 +65,14 @@ class EarlyTranscripts:
             return guess.result()
         log.debug("no early transcript for %s: transcribing now", path)
         return self.recognizer.utterance(audio=path)
+
+    def _transcribe(self, path: Path, pcm: bytes) -> str:
+        """On the worker: a guess's WAV exists only while it is transcribed (a long session keeps none)."""
+        write_wav(path, pcm, SAMPLE_RATE)
+        try:
+            return self.recognizer.utterance(audio=path)
+        finally:
+            path.unlink(missing_ok=True)
 
     def close(self) -> None:
         self._worker.shutdown(wait=False, cancel_futures=True)

@@ -68,6 +68,7 @@ def test_a_pause_that_ends_the_turn_gives_its_transcript_without_a_second_pass(e
     text = early.transcript(ended(tmp_path, utterances.pcm))
     assert early.started == 1 and early.used == 1
     assert early.recognizer.heard == ["early-0001.wav"] and text.endswith("bytes")
+    assert not list((tmp_path / "early").glob("*.wav"))  # a guess's audio lives only while transcribed
 
 
 def test_speech_that_goes_on_is_transcribed_at_its_end(early, tmp_path):
