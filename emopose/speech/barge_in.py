@@ -69,9 +69,11 @@ class BargeIn:
 
     def feed(self, mic: bytes, reference: bytes | None = None) -> list[SpeechEvent]:
         """One stretch of microphone audio (and the robot's playback over the same stretch)."""
+        if reference is not None and not self._with_reference:
+            # the microphone samples still waiting for a whole chunk were heard with no robot playing
+            self._with_reference, self._reference = True, bytes(len(self._mic))
         self._mic += mic
-        if reference is not None or self._with_reference:
-            self._with_reference = True
+        if self._with_reference:
             reference = (reference or b"")[:len(mic)]
             self._reference += reference + bytes(len(mic) - len(reference))
         events = []

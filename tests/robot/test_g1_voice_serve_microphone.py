@@ -49,7 +49,9 @@ def test_the_robots_microphone_feeds_serves_vad_and_the_reply_is_spoken_by_the_r
                   f"asr.listening.mic_port={port}", "asr.listening.mic_interface_ip=127.0.0.1")
     with private_fake_robot(tmp_path) as robot, served(tmp_path, robot, *microphone) as (_, run, player):
         transcribed = []
-        monkeypatch.setattr(run.resources.asr, "utterance", lambda audio: transcribed.append(audio) or HEARD)
+        # the cut WAV as the recognizer gets it (an early guess's WAV is removed once transcribed)
+        monkeypatch.setattr(run.resources.asr, "utterance",
+                            lambda audio: transcribed.append((audio, audio.exists())) or HEARD)
         (tmp_path / "mic").mkdir()
         source = FakeRobot(robot.domain_id + 1, tmp_path / "mic" / "fake.jsonl",  # only its microphone
                            ["--mic-wav", wav, "--mic-target", f"127.0.0.1:{port}", "--mic-delay", "0.2"])
@@ -59,7 +61,7 @@ def test_the_robots_microphone_feeds_serves_vad_and_the_reply_is_spoken_by_the_r
             wait_until(lambda: light_states(robot)[-1:] == ["listening"], "listening after the reply")
         finally:
             source.stop()
-    assert len(transcribed) == 1 and transcribed[0].exists()  # one utterance, cut into its own WAV
+    assert len(transcribed) == 1 and transcribed[0][1]  # one utterance, cut into its own WAV
     assert light_states(robot) == ["listening", "thinking", "speaking", "listening", "off"]
     chunks = [r for r in robot.entries("voice_chunk") if r["stream_id"] == player.clips[-1][0]]
     assert len(chunks) == player.sender.chunks_sent > 0 and player.clip.text == HEARD  # the robot said it

@@ -125,3 +125,21 @@ def test_after_the_robot_stops_speech_is_a_turn_not_a_barge_in(espeak):
     events = barge.feed(silence(0.5) + speech + silence(1.0))
     assert calls == [] and [e.kind for e in events] == ["start", "end"]
     assert ends == [events[1].t_s]
+
+
+def test_a_reference_that_starts_mid_chunk_stays_aligned_with_the_microphone():
+    """Microphone samples left over from before the robot spoke (an odd packet size, as the G1's UDP
+    microphone sends) were heard with no playback: the reference starts with zeros for them."""
+    barge = BargeIn(on_barge_in=lambda t: None, detector=fake_detector([0.0] * 4))
+    heard = []
+    barge.echo.residual = lambda mic, reference: heard.append(reference) or mic
+    barge.echo.above_floor = lambda: False
+    barge.echo.learn = lambda double_talk: None
+    leftover = 192  # samples
+    barge.feed(silence(leftover / SAMPLE_RATE))
+    playback = np.arange(1, 2 * CHUNK_BYTES // 2 + 1, dtype="<i2").tobytes()
+    barge.feed(bytes(len(playback)), playback)
+    assert [len(r) for r in heard] == [CHUNK_BYTES // 2] * 2
+    played = np.concatenate(heard) * 32768.0
+    assert np.all(played[:leftover] == 0)
+    assert np.array_equal(played[leftover:], np.arange(1, len(played) - leftover + 1))
