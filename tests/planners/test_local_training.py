@@ -7,7 +7,7 @@ import json
 import pytest
 
 from emopose.planners.local.data import load_examples
-from emopose.planners.local.model import CONTEXT_CHARS, ActModel, context_prefix
+from emopose.planners.local.model import CONTEXT_CHARS, ActModel, context_prefix, layers
 from tests.planners.local_helpers import training_config
 
 DIALOGUE = ({"role": "user", "content": "Can my son touch the starfish?"},
@@ -60,6 +60,23 @@ def test_dialogue_items_and_distractors_are_training_examples(tmp_path):
     original = [e for e in examples if e.id == "q1"][0]
     assert any((e.text, e.acts, e.anchors) == (original.text, original.acts, original.anchors)
                for e in distractors)
+
+
+@pytest.mark.parametrize("attention", ["sdpa", "eager"])
+def test_layers_run_one_by_one_equal_the_bodys_own_forward_on_a_padded_batch(model, attention, monkeypatch):
+    # training and inference run the encoder layer by layer (frozen ones cached); padding must not leak
+    import torch
+
+    monkeypatch.setattr(model.body.config, "_attn_implementation", attention)
+    tokens = model.tokens(["Hi there, welcome to the lab, everyone!", "No."])
+    real = tokens.inputs["attention_mask"].bool()
+    with torch.no_grad():
+        whole = model.body(**tokens.inputs).last_hidden_state
+        hidden = model.body.embeddings(input_ids=tokens.inputs["input_ids"],
+                                       token_type_ids=tokens.inputs["token_type_ids"])
+        by_layer = layers(model.body, hidden, tokens.inputs["attention_mask"], model.body.encoder.layer)
+    assert not real.all()  # the short text is padded
+    assert torch.allclose(by_layer[real], whole[real], atol=1e-5)
 
 
 def test_frozen_layers_run_once_and_every_epoch_shows_progress(model, tmp_path, capsys, monkeypatch):

@@ -48,8 +48,15 @@ def context_prefix(history: Sequence[dict]) -> str:
 
 
 def layers(body, hidden, attention_mask, stack):
-    """Run encoder layers over hidden states (B, T, D) with the body's own attention mask."""
-    mask, _ = body._create_attention_masks(attention_mask, None, hidden, None, None)
+    """Run encoder layers over hidden states (B, T, D), padding masked as the body's own forward masks it.
+
+    The mask is built here, not by transformers' private mask builder (whose signature changed in 5.x):
+    an additive (B, 1, 1, T) mask, 0 on real tokens and the dtype's minimum on padding, which both the
+    eager and the SDPA attention of a bidirectional encoder add to their scores."""
+    import torch
+
+    keep = attention_mask[:, None, None, :].to(hidden.dtype)
+    mask = (1.0 - keep) * torch.finfo(hidden.dtype).min
     for layer in stack:
         hidden = layer(hidden, mask)
     return hidden
