@@ -52,28 +52,52 @@ def test_synthetic_sequences_join_items_of_different_classes():
     assert len({e.text for e in joined}) > 20
 
 
-def test_trigger_is_the_marked_run_of_whole_words_around_the_peak():
+def word_analysis(text: str, onset_word: str, marked: tuple[str, ...] = (), peak: str | None = None,
+                  occurrence: int = 0) -> Analysis:
+    """One token per word: the onset head peaks on the given occurrence of onset_word, the anchor head
+    marks the `marked` words and is strongest on `peak` (default: the onset word)."""
+    found = list(re.finditer(r"[\w']+", text))
+    words, starts = [m.group() for m in found], [m.start() for m in found]
+    at = lambda word: [k for k, w in enumerate(words) if w == word][occurrence]  # noqa: E731
+    onset = np.full(len(words), -3.0)
+    onset[at(onset_word)] = 2.0
+    anchor = np.array([1.0 if w in marked else -1.0 for w in words])
+    anchor[at(peak or onset_word)] = 2.0
+    return Analysis(starts, None, None, None, anchor, onset)
+
+
+def test_trigger_starts_at_the_onset_word_and_runs_to_the_end_of_the_marked_phrase():
     text = "Thanks for coming, the cloakroom is downstairs on the left."
     act = (19, len(text) - 1)
-    words = [(m.start(), m.group()) for m in re.finditer(r"[\w']+", text)]
-    starts = [s for s, _ in words]
-    logits = np.full(len(starts), -3.0)
-    peak = [w for _, w in words].index("downstairs")
-    logits[peak] = 2.0
-    logits[peak - 1] = 0.5  # "is" is marked too; the unmarked "cloakroom" is not
-    analysis = Analysis(starts, None, None, None, logits)
-    start, end = trigger_span(text, analysis, act)
-    assert text[start:end] == "is downstairs"
-    logits[:] = 1.0  # everything marked: capped at six words
-    start, end = trigger_span(text, analysis, act, max_words=6)
-    assert len(text[start:end].split()) == 6 and "downstairs" in text[start:end]
-    assert act[0] <= start and end <= act[1]
-    logits[:] = -1.0
-    logits[-1] = 3.0  # the peak on the final full stop: the last word carries the trigger
-    starts.append(len(text) - 1)
-    analysis = Analysis(starts, None, None, None, np.append(logits, 5.0))
-    start, end = trigger_span(text, analysis, (0, len(text)))
-    assert text[start:end] == "left"
+    analysis = word_analysis(text, "downstairs", ("cloakroom", "is", "on", "the", "left"))
+    assert text[slice(*trigger_span(text, analysis, act))] == "downstairs on the left"  # not "cloakroom is"
+    analysis = word_analysis(text, "downstairs", ("the", "left"))  # a gap after the onset word ends it
+    assert text[slice(*trigger_span(text, analysis, act))] == "downstairs"
+    analysis = word_analysis(text, "the", tuple(re.findall(r"\w+", text)))
+    span = trigger_span(text, analysis, act, max_words=3)  # everything marked: capped
+    assert text[slice(*span)] == "the cloakroom is" and act[0] <= span[0] and span[1] <= act[1]
+
+
+def test_the_onset_is_never_after_the_phrases_strongest_word():
+    text = "Thanks for coming, the cloakroom is downstairs on the left."
+    analysis = word_analysis(text, "left", ("is",), peak="cloakroom")
+    assert text[slice(*trigger_span(text, analysis, (19, len(text) - 1)))] == "the cloakroom is"
+
+
+def test_a_trigger_is_extended_until_the_reply_has_it_nowhere_earlier():
+    text = "The lamp by the window is new, and the one by the door is old."
+    act = (text.index("and"), len(text) - 1)
+    analysis = word_analysis(text, "by", (), occurrence=1)  # "by" and "by the" occur earlier
+    assert text[slice(*trigger_span(text, analysis, act))] == "by the door"
+
+
+def test_an_onset_on_punctuation_gives_the_word_before_it():
+    text = "Thanks for coming, the cloakroom is downstairs on the left."
+    analysis = word_analysis(text, "left")
+    analysis.starts.append(len(text) - 1)  # the final full stop is a token of its own, both heads' peak
+    analysis.onset_logits = np.append(np.full(len(analysis.anchor_logits), -3.0), 5.0)
+    analysis.anchor_logits = np.append(np.full(len(analysis.anchor_logits), -1.0), 3.0)
+    assert text[slice(*trigger_span(text, analysis, (0, len(text))))] == "left"
 
 
 def test_train_local_search_is_checked_before_anything_is_built():

@@ -128,3 +128,27 @@ def test_linear_schedule_warms_up_then_decays_to_zero():
     assert all(a >= b for a, b in zip(rates[4:], rates[5:])) and rates[-1] == pytest.approx(1 / 95)
     constant = learning_rate_factor(training_config(lr_schedule="constant"), 100)
     assert {constant(step) for step in range(100)} == {1.0}
+
+
+def test_the_onset_loss_targets_each_anchors_first_token_within_its_act(model, monkeypatch):
+    import torch
+
+    from emopose.planners.local.data import multi_act
+    from emopose.planners.local.losses import onset_loss
+
+    example = multi_act({"id": "o", "text": "Hi there! The exit is on your left.",
+                         "labels": ["welcoming", "pointing"], "anchors": ["Hi there", "on your left"]})
+    tokens = model.tokens([example.text])
+    positions = {start: tokens.real[0][k] for k, start in enumerate(tokens.starts[0])}
+
+    def peaked_at(*chars: int) -> float:
+        logits = torch.full((1, tokens.inputs["input_ids"].shape[1], 1), -10.0)
+        for char in chars:
+            logits[0, positions[char]] = 10.0
+        monkeypatch.setattr(model, "onset_head", lambda states: logits)
+        return float(onset_loss(model, [example], tokens, None, [0]))
+
+    anchors = [start for start, _ in example.anchors]
+    acts = [act.start for act in example.acts]
+    assert anchors[1] != acts[1]  # the pointing act starts at "The", its anchor at "on"
+    assert peaked_at(*anchors) < 1e-3 < 5.0 < peaked_at(*acts)

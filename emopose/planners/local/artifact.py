@@ -19,7 +19,7 @@ from emopose.planners.local.data import load_examples
 from emopose.planners.local.model import ActModel
 
 log = logging.getLogger(__name__)
-ARTIFACT_VERSION = 16
+ARTIFACT_VERSION = 17
 
 
 def artifact_path(paths: list[str], cache_dir: str | Path, config: TrainingConfig) -> Path:

@@ -6,6 +6,9 @@
   states of the segments on either side; act and boundary logits are also the potentials of the
   semi-Markov CRF over segments (planners/semi_crf.py), which is how the planner splits;
 - anchor head: per token, whether it belongs to the phrase that carries the act (the trigger);
+- onset head: per token, how likely the act's trigger starts there (its affiliate's first word, where the
+  stroke lands): a softmax over the act's tokens picks it, which a per-token inside/outside score cannot
+  (the first words of a phrase are where that score is least sure);
 - relevance head: whether the dialogue history read before the utterance bears on it, from the
   [CLS] state, which attends to both (BERT's sentence-pair head; a history that does not bear on the
   utterance is dropped: planners/local.py).
@@ -37,6 +40,7 @@ class Analysis:
     semantic_states: object  # torch (T, D), from the pretrained top layers (sentence similarity)
     lexical_states: object  # torch (T, D), the word embeddings (which words)
     anchor_logits: np.ndarray  # (T,)
+    onset_logits: np.ndarray  # (T,) compared within one act only
     relevance_logit: float | None = None  # whether the history bears on the text (None: read without one)
     token_ids: np.ndarray | None = None  # (T,); with word_weights, needed by variant_features only
     word_weights: object = None  # torch (T,), how distinctive each token is
@@ -74,7 +78,8 @@ def boundary_features(left, right):
 
 
 def new_heads(width: int) -> tuple:
-    """(act head, boundary head, anchor head, relevance head), freshly initialised (seed first)."""
+    """(act head, boundary head, anchor head, relevance head, onset head), freshly initialised (seed
+    first)."""
     import torch
 
     # created in this order: the seeded initialisation depends on it
@@ -82,7 +87,8 @@ def new_heads(width: int) -> tuple:
     boundary = torch.nn.Sequential(torch.nn.Linear(4 * width, 64), torch.nn.ReLU(), torch.nn.Linear(64, 1))
     anchor = torch.nn.Linear(width, 1)
     relevance = torch.nn.Linear(width, 1)
-    return act, boundary, anchor, relevance
+    onset = torch.nn.Linear(width, 1)
+    return act, boundary, anchor, relevance, onset
 
 
 def span_scores(act_head, logit_scale: float, analysis: Analysis,

@@ -104,10 +104,12 @@ class LocalInference:
             for k, idx in enumerate(tokens.real):
                 states = class_states[k, idx].float()
                 anchor = self.model.anchor_head(states).squeeze(-1).numpy()
+                onset = self.model.onset_head(states).squeeze(-1).numpy()
                 relevance = (float(self.model.relevance_head(class_states[k, 0].float()))
                              if tokens.prefixed[k] else None)
                 out.append(Analysis(tokens.starts[k], states, semantic[k, idx].float(), words[k, idx], anchor,
-                                    relevance, tokens.inputs["input_ids"][k, idx].numpy(), weights[k, idx]))
+                                    onset, relevance, tokens.inputs["input_ids"][k, idx].numpy(),
+                                    weights[k, idx]))
         return out
 
     def readable(self, text: str) -> bool:

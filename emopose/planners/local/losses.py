@@ -4,7 +4,8 @@
 - relevance (binary per item read after a history: its own dialogue's, or a distractor's unrelated one);
 - boundaries (binary, at every candidate segment boundary) and the semi-CRF likelihood of the
   annotated split against every other split of the segments (planners/local/semi_crf.py);
-- anchors (binary per token: inside the annotated trigger phrase).
+- anchors (binary per token: inside the annotated trigger phrase) and their onsets (cross-entropy over
+  the tokens of the act each anchor lies in: which one the anchor starts at).
 
 Every head runs once over the whole batch: the act, span and segment vectors are gathered from one
 cumulative sum (per-example head calls took half of each step).
@@ -57,6 +58,7 @@ def batch_loss(model: ActModel, batch: list[Example], tokens, lower):
     anchored = [k for k, e in enumerate(batch) if e.anchors]
     if anchored:
         loss = loss + cfg.anchor_loss_weight * anchor_loss(model, batch, tokens, class_states, anchored)
+        loss = loss + cfg.anchor_loss_weight * onset_loss(model, batch, tokens, class_states, anchored)
     return loss
 
 
@@ -99,6 +101,27 @@ def anchor_loss(model: ActModel, batch: list[Example], tokens, class_states, anc
     labels = [float(any(a <= s < b for a, b in batch[k].anchors)) for k in anchored for s in tokens.starts[k]]
     rows, cols = zip(*positions)
     return bce(logits[list(rows), list(cols)], torch.tensor(labels))
+
+
+def onset_loss(model: ActModel, batch: list[Example], tokens, class_states, anchored: list[int]):
+    """Mean cross-entropy of each anchor's first token among the tokens of the act it lies in."""
+    import torch
+    from torch.nn.functional import cross_entropy
+
+    logits = model.onset_head(class_states).squeeze(-1)
+    losses = []
+    for k in anchored:
+        starts, real = tokens.starts[k], tokens.real[k]
+        for begin, _ in batch[k].anchors:
+            act = next((a for a in batch[k].acts if a.start <= begin < a.end), None)
+            if act is None:
+                continue
+            first, last = token_range(starts, act.start, act.end)
+            target = token_range(starts, begin, begin + 1)[0]
+            if first <= target < last:
+                row = logits[k, real[first]:real[last - 1] + 1]
+                losses.append(cross_entropy(row.unsqueeze(0), torch.tensor([target - first])))
+    return torch.stack(losses).mean() if losses else logits.new_zeros(())
 
 
 class BatchPool:

@@ -1,4 +1,4 @@
-"""The local planner's model: all-MiniLM-L6-v2 with its top layers fine-tuned, four heads, two projections.
+"""The local planner's model: all-MiniLM-L6-v2 with its top layers fine-tuned, five heads, two projections.
 
 The encoder reads the dialogue and the utterance as one input: the last turns with role markers
 ("guide: ... visitor: ... [SEP] utterance"), so every utterance token attends to the history and an
@@ -6,7 +6,7 @@ elliptical reply ("That one, with the feathers.") is read in context; a relevanc
 the history bears on the utterance at all. Only the utterance's tokens are
 kept; their character starts are relative to the utterance. One forward pass gives three states per token:
 
-- class states from the fine-tuned top layers, read by the act, boundary, anchor and relevance heads
+- class states from the fine-tuned top layers, read by the act, boundary, anchor, onset and relevance heads
   (planners/local_heads.py);
 - semantic states: the pretrained sentence encoder's own output (a frozen copy of the top layers run
   over the same lower states; mean-pooled, this is all-MiniLM-L6-v2's sentence embedding);
@@ -71,7 +71,7 @@ class Tokens:
 
 
 class ActModel:
-    """MiniLM + act / boundary / anchor / relevance heads and the variant projections: weights and the
+    """MiniLM + act / boundary / anchor / relevance / onset heads and the variant projections: weights and the
     forward pass."""
 
     def __init__(self, config: TrainingConfig) -> None:
@@ -86,14 +86,15 @@ class ActModel:
         self.sentence_top = copy.deepcopy(self.body.encoder.layer[self.frozen_depth:]).requires_grad_(False)
         width = self.body.config.hidden_size
         torch.manual_seed(config.seed)
-        self.act_head, self.boundary_head, self.anchor_head, self.relevance_head = new_heads(width)
+        (self.act_head, self.boundary_head, self.anchor_head, self.relevance_head,
+         self.onset_head) = new_heads(width)
         self.variant_projections = new_projections(width)  # (semantic, lexical)
         self.word_frequency = torch.zeros(self.body.config.vocab_size)  # in the training texts (learn_words)
         self.annotated_motions: list[str] = []  # motions the training data annotates (set by training)
 
     @property
     def heads(self) -> list:
-        return [self.act_head, self.boundary_head, self.anchor_head, self.relevance_head,
+        return [self.act_head, self.boundary_head, self.anchor_head, self.relevance_head, self.onset_head,
                 *self.variant_projections]
 
     @property

@@ -164,8 +164,8 @@ def fit_top(model: ActModel, top, cache: list[tuple], examples: int, rng: random
     from tqdm import tqdm
 
     cfg = model.config
-    heads = [q for h in (model.act_head, model.boundary_head, model.anchor_head, model.relevance_head)
-             for q in h.parameters()]
+    heads = [q for h in (model.act_head, model.boundary_head, model.anchor_head, model.relevance_head,
+                         model.onset_head) for q in h.parameters()]
     optimizer = torch.optim.AdamW([{"params": list(top.parameters()), "lr": cfg.lr},
                                    {"params": heads, "lr": cfg.head_lr}], weight_decay=0.01)
     steps = cfg.epochs * len(cache)
