@@ -17,8 +17,9 @@ from dataclasses import dataclass
 
 from emopose.bench.sequence_metrics import SequencePrediction, item_scores
 from emopose.bench.suites import SequenceItem
+from emopose.planners.local.affiliate import act_trigger
 from emopose.planners.local.data import Example, load_examples
-from emopose.planners.local.planner import LocalPlanner, ScoredUtterance, act_trigger
+from emopose.planners.local.planner import LocalPlanner, ScoredUtterance
 from emopose.resources import Run
 from emopose.results import JobOutput, markdown_table
 

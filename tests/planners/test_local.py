@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from emopose.planners.base import PlanRequest
+from emopose.planners.local.affiliate import trigger_span
 from emopose.planners.local.data import multi_act, single_act, synthetic_sequences
 from emopose.planners.local.heads import Analysis
-from emopose.planners.local.planner import intensity_from_cues, trigger_span
+from emopose.planners.local.planner import intensity_from_cues
 from emopose.planners.local.segment import segments
 from emopose.stages.parse import parse_plan
 from tests.planners.local_helpers import configured_local_planner

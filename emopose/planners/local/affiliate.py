@@ -1,7 +1,8 @@
-"""The lexical affiliate inside a trigger: where the words the gesture belongs to start (issue 29).
+"""Where an act's trigger lies: the lexical affiliate, the words the gesture belongs to (issue 29).
 
-The anchor and onset heads learned the affiliate from the training anchors (experiments/train/ANCHORS.md),
-but where they still start a trigger at its clause ("the kennel is over to your left" for "over to your
+trigger_span reads it from the model: the anchor head marks the phrase that carries the act, the onset
+head its first word (both learned from the training anchors, experiments/train/ANCHORS.md). Where they
+still start a trigger at its clause ("the kennel is over to your left" for "over to your
 left": the contract, contract.TRIGGER_RULE, wants the place pointed at, a statement's new information,
 the hedge, the yes, no or greeting), its left edge is trimmed by three documented rules of English clause
 structure, never by words of any suite (0.4 points of the held-out slice's onsets, issue 29):
@@ -24,7 +25,10 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
+
 from emopose.contract import trigger_position
+from emopose.planners.local.heads import Analysis
 
 _JOINER = re.compile(r"^(?:(?:and|but|so|then|or|plus)\s+|(?:look|listen|remember|well|now|see)\s*,\s*)",
                      re.IGNORECASE)
@@ -67,3 +71,40 @@ def affiliate_span(text: str, span: tuple[int, int], cls: str) -> tuple[int, int
     trimmed = affiliate(text[start:end], cls)
     moved = end - len(trimmed)
     return (moved, end) if trigger_position(text, trimmed) == moved else span
+
+
+def trigger_span(text: str, analysis: Analysis, act: tuple[int, int], max_words: int = 6) -> tuple[int, int]:
+    """Character span of the act's trigger. The anchor head marks the phrase that carries the act (the
+    run of positive logits around its strongest token); the trigger starts at the word the onset head
+    rates highest in the act up to that token (the affiliate's first word, where the stroke lands) and
+    runs to the phrase's end or over the following words the anchor head marks, at most max_words words;
+    it is extended a word at a time while the same words occur earlier in the reply (the schedule finds
+    a trigger at its first occurrence)."""
+    first, last = analysis.token_range(*act)
+    words = list(_WORD.finditer(text, act[0], act[1]))
+    if not words:
+        return act
+    logits = analysis.anchor_logits
+    peak = phrase_end = first + int(np.argmax(logits[first:last]))
+    while phrase_end + 1 < last and logits[phrase_end + 1] > 0:
+        phrase_end += 1
+    onset = analysis.starts[first + int(np.argmax(analysis.onset_logits[first:peak + 1]))]
+    # the onset may be a punctuation token: its word is the last one starting at or before it
+    lo = max((k for k, m in enumerate(words) if m.start() <= onset), default=0)
+
+    def inside(word: re.Match) -> bool:
+        a, b = analysis.token_range(word.start(), word.end())
+        return word.start() <= analysis.starts[phrase_end] or bool(np.any(logits[a:b] > 0))
+
+    hi = lo
+    while hi + 1 < len(words) and hi - lo + 1 < max_words and inside(words[hi + 1]):
+        hi += 1
+    while (trigger_position(text, text[words[lo].start():words[hi].end()]) != words[lo].start()
+           and hi + 1 < len(words) and hi - lo + 1 < max_words):
+        hi += 1
+    return words[lo].start(), words[hi].end()
+
+
+def act_trigger(text: str, analysis: Analysis, act: tuple[int, int], cls: str) -> tuple[int, int]:
+    """A `cls` act's trigger span: trigger_span, its left edge trimmed by the clause rules (affiliate.py)."""
+    return affiliate_span(text, trigger_span(text, analysis, act), cls)

@@ -14,7 +14,7 @@
    (planners/local/direction.py); intensity from cues (intensifiers and exclamations up, hedges down);
    trigger = the words the gesture belongs to (the contract's rule: its lexical affiliate, starting at the
    word the stroke lands on): from the word the onset head picks to the end of the phrase the anchor
-   head marks (trigger_span), a leading subject or joiner the clause rules find still trimmed
+   head marks (affiliate.trigger_span), a leading subject or joiner the clause rules find still trimmed
    (planners/local/affiliate.py); reply = the input text (it always narrates).
 
 The model is trained by `+experiment=train_local`, or before first use when planner.train_if_missing
@@ -33,11 +33,10 @@ from pathlib import Path
 import numpy as np
 
 from emopose import CLASSES
-from emopose.contract import trigger_position
 from emopose.library import MotionLibrary
 from emopose.planners.base import PlannerOutput, PlanRequest, timed
 from emopose.planners.local import semi_crf
-from emopose.planners.local.affiliate import affiliate_span
+from emopose.planners.local.affiliate import act_trigger
 from emopose.planners.local.artifact import (
     cached_artifact,
     load_model,
@@ -57,7 +56,6 @@ _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|tru
                  r"always|huge|amazing|terrible|must)\b", re.IGNORECASE)
 _DOWN = re.compile(r"\b(maybe|perhaps|a bit|a little|slightly|kind of|sort of|somewhat|might|"
                    r"possibly|i guess|quietly|gently)\b", re.IGNORECASE)
-_WORDS = re.compile(r"[\w'-]+")
 log = logging.getLogger(__name__)
 
 
@@ -67,43 +65,6 @@ def intensity_from_cues(text: str) -> int:
     if len(letters) >= 4 and sum(c.isupper() for c in letters) / len(letters) > 0.6:
         score += 1
     return int(min(5, max(1, score)))
-
-
-def trigger_span(text: str, analysis: Analysis, act: tuple[int, int], max_words: int = 6) -> tuple[int, int]:
-    """Character span of the act's trigger. The anchor head marks the phrase that carries the act (the
-    run of positive logits around its strongest token); the trigger starts at the word the onset head
-    rates highest in the act up to that token (the affiliate's first word, where the stroke lands) and
-    runs to the phrase's end or over the following words the anchor head marks, at most max_words words;
-    it is extended a word at a time while the same words occur earlier in the reply (the schedule finds
-    a trigger at its first occurrence)."""
-    first, last = analysis.token_range(*act)
-    words = list(_WORDS.finditer(text, act[0], act[1]))
-    if not words:
-        return act
-    logits = analysis.anchor_logits
-    peak = phrase_end = first + int(np.argmax(logits[first:last]))
-    while phrase_end + 1 < last and logits[phrase_end + 1] > 0:
-        phrase_end += 1
-    onset = analysis.starts[first + int(np.argmax(analysis.onset_logits[first:peak + 1]))]
-    # the onset may be a punctuation token: its word is the last one starting at or before it
-    lo = max((k for k, m in enumerate(words) if m.start() <= onset), default=0)
-
-    def inside(word: re.Match) -> bool:
-        a, b = analysis.token_range(word.start(), word.end())
-        return word.start() <= analysis.starts[phrase_end] or bool(np.any(logits[a:b] > 0))
-
-    hi = lo
-    while hi + 1 < len(words) and hi - lo + 1 < max_words and inside(words[hi + 1]):
-        hi += 1
-    while (trigger_position(text, text[words[lo].start():words[hi].end()]) != words[lo].start()
-           and hi + 1 < len(words) and hi - lo + 1 < max_words):
-        hi += 1
-    return words[lo].start(), words[hi].end()
-
-
-def act_trigger(text: str, analysis: Analysis, act: tuple[int, int], cls: str) -> tuple[int, int]:
-    """A `cls` act's trigger span: trigger_span, its left edge trimmed by the clause rules (affiliate.py)."""
-    return affiliate_span(text, trigger_span(text, analysis, act), cls)
 
 
 @dataclass
