@@ -2,9 +2,10 @@
 recorded message, for the kill -9 tests.
 
 Each message the Recorder takes is logged as one line `<wall ns> <log time ns> <topic>` to the file named
-by $EMOPOSE_WITNESS, with an unbuffered write(2) straight after the Recorder's own call: a SIGKILL
-leaves every line the kernel took, so the test knows which messages existed at any wall time before the
-kill (a virtual-clock job's log times say nothing about the wall clock).
+by $EMOPOSE_WITNESS, with an unbuffered write(2) straight after the Recorder's own call, and each flush
+that reached the disk as `<wall ns it began> flush <wall ns its fsync returned>`: a SIGKILL leaves every
+line the kernel took, so the test knows which messages existed before which flush (a virtual-clock job's
+log times say nothing about the wall clock, and on a busy machine the flusher's wall cadence says little).
 """
 
 from __future__ import annotations
@@ -29,15 +30,27 @@ def witness_every_message(fd: int) -> None:
             os.write(fd, f"{time.time_ns()} {stamp} {topic}\n".encode())
 
     Recorder._queue = witnessed
+    flush = Recorder.flush
+
+    def witnessed_flush(self):
+        began = time.time_ns()
+        flush(self)
+        os.write(fd, f"{began} flush {time.time_ns()}\n".encode())
+
+    Recorder.flush = witnessed_flush
 
 
-def read_witness(path) -> list[tuple[int, int, str]]:
-    """(wall ns, log time ns, topic) of every witnessed message."""
-    rows = []
+def read_witness(path) -> tuple[list[tuple[int, int, str]], list[tuple[int, int]]]:
+    """(wall ns, log time ns, topic) of every witnessed message; (began, ended) wall ns of every flush
+    that was on disk before the kill."""
+    messages, flushes = [], []
     for line in path.read_text().splitlines():
-        wall, stamp, topic = line.split(" ", 2)
-        rows.append((int(wall), int(stamp), topic))
-    return rows
+        first, second, third = line.split(" ", 2)
+        if second == "flush":
+            flushes.append((int(first), int(third)))
+        else:
+            messages.append((int(first), int(second), third))
+    return messages, flushes
 
 
 if __name__ == "__main__":
