@@ -119,6 +119,35 @@ def test_the_model_keeps_which_motions_its_training_data_annotates(model, tmp_pa
     assert restored.annotated_motions == ["face_wave", "point_left"]
 
 
+def test_motions_the_data_never_annotates_do_not_change_what_training_learns(tmp_path):
+    # the artifact is keyed by the training files alone, so the live library's other motions must not
+    # shape it (they would be negatives of the variant projections)
+    import torch
+
+    from emopose.planners.local.training import fit
+
+    path = write_jsonl(tmp_path / "train.jsonl", [
+        {"id": "a", "text": "Hi there! The exit is on your left.", "labels": ["welcoming", "pointing"],
+         "anchors": ["Hi there", "on your left"], "variants": ["face_wave", "point_left"]},
+        {"id": "b", "text": "Good morning! Take the stairs on the right.", "labels": ["welcoming", "pointing"],
+         "anchors": ["Good morning", "on the right"], "variants": ["open_arms", "point_forward_right"]},
+        {"id": "c", "text": "Welcome aboard! The deck is up there.", "labels": ["welcoming", "pointing"],
+         "anchors": ["Welcome aboard", "up there"], "variants": ["bow", "point_up"]}])
+    known = {"face_wave": ("welcoming", "face wave: a wave by the face"),
+             "open_arms": ("welcoming", "open arms: arms spread to greet"),
+             "bow": ("welcoming", "bow: a polite bow to a guest"),
+             "point_left": ("pointing", "point left: the arm points to the left"),
+             "point_forward_right": ("pointing", "point forward right: the arm points ahead and right"),
+             "point_up": ("pointing", "point up: the arm points at the ceiling")}
+    projections = []
+    for catalogue in (known, {**known, "sailor_salute": ("welcoming", "sailor salute: a greeting aboard")}):
+        model = ActModel(training_config(trainable_layers=1, epochs=1, batch_size=4))
+        fit(model, load_examples([path], 0), catalogue, progress=False)
+        projections.append([p.weight.detach().clone() for p in model.variant_projections])
+    assert not torch.equal(projections[0][0], torch.eye(projections[0][0].shape[0]))  # they were trained
+    assert all(torch.equal(a, b) for a, b in zip(*projections))
+
+
 def test_linear_schedule_warms_up_then_decays_to_zero():
     from emopose.planners.local.training import learning_rate_factor
 
