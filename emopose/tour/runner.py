@@ -38,7 +38,8 @@ DEFAULT_ANSWER = "That is a good question; let me tell you more about it after t
 
 class TourRunner:
     """Runs one tour in `run`: its turn runner says the lines and keeps the dialogue, and the
-    resources' scene slot tells the aim stage what the robot is looking at."""
+    resources' scene slot tells the aim stage what the robot is looking at. The runner closes the camera
+    it is given when the tour ends."""
 
     def __init__(self, run: Run, spec: TourSpec, base: MobileBase, camera: Camera,
                  interruptions: Interruptions | None = None, answer_planner: Planner | None = None) -> None:
@@ -75,6 +76,7 @@ class TourRunner:
                 self.turns.dialogue.said(closing.text)
         finally:
             self.come_to_rest()
+            self.camera.close()
             if light is not None:
                 light.close()
             self.report.finish(self.sequencer.events.since(first_event), self.aborted,
@@ -158,7 +160,7 @@ class TourRunner:
             line = self.say(self.spec.abort_reply, "abort", question=question.text)
             exchange.aborted = self.aborted = True
         else:
-            image = self.camera.frame_png() if asks_about_scene(question.text) else None
+            image = self.camera.frame_image() if asks_about_scene(question.text) else None
             exchange.image_attached = image is not None
             answerer = self.answer_planner
             if isinstance(answerer, ModalPlanner) and answerer.mode is PlannerMode.RESPOND:  # answers itself

@@ -18,7 +18,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "planners"))
 from fake_openai import FakeOpenAI
 
 from emopose.app import run
-from tests.tour.tour_helpers import RENDER_SKIP, small, tour_config
+from emopose.tour.camera import camera_for
+from tests.tour.tour_helpers import RENDER_SKIP, small, tour_config, tour_runner
 
 
 def user_content(body: dict):
@@ -43,7 +44,7 @@ def test_scene_question_attaches_the_head_camera_frame_to_the_vlm_request(tmp_pa
     assert text == {"type": "text", "text": "What is this?"}  # the visitor's own words: respond mode
     assert image["type"] == "image_url"
     url = image["image_url"]["url"]
-    assert url.startswith("data:image/png;base64,")
+    assert url.startswith("data:image/jpeg;base64,")
     import imageio.v3 as iio
 
     frame = iio.imread(io.BytesIO(base64.b64decode(url.split(",", 1)[1])))
@@ -56,3 +57,26 @@ def test_scene_question_attaches_the_head_camera_frame_to_the_vlm_request(tmp_pa
     exchange = results["exchanges"][0]
     assert exchange["image_attached"] and exchange["question"] == "What is this?"
     assert results["stops_within_tolerance"] == 1 and results["ended_at_rest"]
+
+
+@pytest.mark.skipif(RENDER_SKIP is not None, reason=str(RENDER_SKIP))
+def test_the_head_camera_shows_the_simulators_state_rendered_outside_the_loops_process(tmp_path, monkeypatch):
+    import imageio.v3 as iio
+    import numpy as np
+
+    with tour_runner(tmp_path, small()) as (run, _):
+        backend = run.resources.backend
+        backend.planar_base.place(0.6, 0.0, 0.0)  # the red box ahead, to the right
+        here = backend.render_frame("head").astype(float)  # in this process, for comparison only
+        backend.planar_base.place(0.6, 0.0, np.pi)  # facing away from it
+        away = backend.render_frame("head").astype(float)
+        backend.planar_base.place(0.6, 0.0, 0.0)
+        monkeypatch.setattr(type(backend), "render_frame", lambda *a, **k: pytest.fail("rendered in-process"))
+        camera = camera_for(backend)
+        try:
+            frame = iio.imread(io.BytesIO(camera.frame_image())).astype(float)
+        finally:
+            camera.close()
+    assert frame.shape == here.shape == (240, 320, 3) and camera.frames == 1
+    # the child's frame is the same view (no MSAA there: edges differ), not the one facing away
+    assert np.abs(frame - here).mean() < 0.5 * np.abs(frame - away).mean()
