@@ -37,8 +37,9 @@ class MujocoHeadCamera:
 
     def frame_image(self) -> bytes | None:
         if self._renderer is None:
-            self._renderer = PoseRenderer(self.backend.model_path, planar_base=self.backend.planar_base is not None,
-                                          width=self.backend.renderer.width, height=self.backend.renderer.height)
+            backend = self.backend
+            self._renderer = PoseRenderer(backend.model_path, planar_base=backend.planar_base is not None,
+                                          width=backend.renderer.width, height=backend.renderer.height)
             if not self._renderer.start():
                 log.warning("head camera unavailable (%s); answering without images", self._renderer.error)
         if not self._renderer.available:

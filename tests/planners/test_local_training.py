@@ -129,7 +129,8 @@ def test_motions_the_data_never_annotates_do_not_change_what_training_learns(tmp
     path = write_jsonl(tmp_path / "train.jsonl", [
         {"id": "a", "text": "Hi there! The exit is on your left.", "labels": ["welcoming", "pointing"],
          "anchors": ["Hi there", "on your left"], "variants": ["face_wave", "point_left"]},
-        {"id": "b", "text": "Good morning! Take the stairs on the right.", "labels": ["welcoming", "pointing"],
+        {"id": "b", "text": "Good morning! Take the stairs on the right.",
+         "labels": ["welcoming", "pointing"],
          "anchors": ["Good morning", "on the right"], "variants": ["open_arms", "point_forward_right"]},
         {"id": "c", "text": "Welcome aboard! The deck is up there.", "labels": ["welcoming", "pointing"],
          "anchors": ["Welcome aboard", "up there"], "variants": ["bow", "point_up"]}])

@@ -1,5 +1,5 @@
-"""The training sequences' anchors keep the checkable rules of experiments/train/ANCHORS.md, whose examples are
-its own."""
+"""The training sequences' anchors keep the checkable rules of experiments/train/ANCHORS.md, whose
+examples are its own."""
 
 import json
 import re
@@ -29,7 +29,8 @@ def test_the_guide_quotes_no_suite_anchor():
     # (single words such as "Yes" or "Absolutely" are the classes' own vocabulary, not an answer)
     root = Path(__file__).parents[2] / "experiments"
     examples = set(re.findall(r'"([^"]+)"', (root / "train" / "ANCHORS.md").read_text()))
-    suite_anchors = {_words(anchor) for suite in ("sequence/sequence_suite.jsonl", "speech/sync_fixture.jsonl")
+    suites = ("sequence/sequence_suite.jsonl", "speech/sync_fixture.jsonl")
+    suite_anchors = {_words(anchor) for suite in suites
                      for line in (root / suite).read_text().splitlines()
                      for anchor in json.loads(line).get("anchors", [])}
     quoted = [example for example in examples if len(_words(example).split()) >= 2]

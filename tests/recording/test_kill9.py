@@ -4,9 +4,9 @@ that reached the disk (the Recorder puts a chunk on disk every FLUSH_S), and the
 
 Which messages existed before which flush comes from a witness (tests/recording/witness.py): the
 virtual-clock jobs' log times say nothing about the wall clock, and on a busy machine a flush can land
-well after its FLUSH_S, so the test asserts no wall-clock age of the lost tail. Times are drawn per job and case from a fixed seed, in a
-window after the recording opened while the job still runs (plan streams ~5 s of gestures, tour ~10 s,
-sync_eval ~100 s; serve runs until stopped). The heavier jobs are marked slow.
+well after its FLUSH_S, so the test asserts no wall-clock age of the lost tail. Times are drawn per job and
+case from a fixed seed, in a window after the recording opened while the job still runs (plan streams ~5 s
+of gestures, tour ~10 s, sync_eval ~100 s; serve runs until stopped). The heavier jobs are marked slow.
 """
 
 from __future__ import annotations
@@ -78,7 +78,8 @@ def test_a_killed_job_is_recovered_up_to_its_last_flush(tmp_path_factory, job, c
     last_flush = max(began for began, _ in flushes)
     old = Counter((stamp, topic) for wall, stamp, topic in witnessed if wall < last_flush)
     lost = old - recovered
-    assert not lost, f"killed {after_s:.2f} s in: lost {sum(lost.values())} flushed messages: {list(lost)[:3]}"
+    assert not lost, (f"killed {after_s:.2f} s in: lost {sum(lost.values())} flushed messages: "
+                      f"{list(lost)[:3]}")
     assert sum(recovered.values()) <= len(witnessed)  # nothing made up
     assert sum(n for (_, topic), n in old.items() if topic == "/joints/command") >= 10, "too early a kill"
     if case == 0:  # the report reads what the recovery wrote
