@@ -44,8 +44,10 @@ MAX_EXAMPLES = 8  # example utterances a motion file may carry
 MAX_REPLY_CHARS = 200
 # What a record's trigger is (README "The planner's contract"; the schema's description says it to a model)
 TRIGGER_RULE = ("the words the gesture belongs to (its lexical affiliate: the place pointed at, the stressed "
-                "words, the yes, no or greeting itself), 1-6 words copied exactly from the reply; its first "
-                "word is where the stroke lands, so it starts there, not at the clause around it")
+                "words, the yes or greeting itself, a refusal's own words after any 'No,' before them, a "
+                "doubt's hedge rather than the question it answers), 1-6 words copied exactly from the "
+                "reply; its first word is where the stroke lands, so it starts there, not at the clause "
+                "around it")
 
 
 class EventKind(StrEnum):

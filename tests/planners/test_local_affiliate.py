@@ -2,7 +2,7 @@
 
 import pytest
 
-from emopose.planners.local.affiliate import affiliate, affiliate_span
+from emopose.planners.local.affiliate import affiliate, affiliate_region, affiliate_span
 
 
 @pytest.mark.parametrize(("phrase", "cls", "expected"), [
@@ -12,6 +12,10 @@ from emopose.planners.local.affiliate import affiliate, affiliate_span
     ("The retake is on the 9th", "neutral", "on the 9th"),
     ("and the lift is out of order", "emphasizing", "out of order"),
     ("but I'm not sure about that", "doubting", "I'm not sure about that"),
+    ("No, the gate stays shut", "rejecting", "the gate stays shut"),  # the refusal, not the no before it
+    ("but no, I won't sign it", "rejecting", "I won't sign it"),
+    ("Sorry, strollers stay downstairs", "rejecting", "strollers stay downstairs"),
+    ("I'm afraid the roof is off limits", "rejecting", "the roof is off limits"),
 ])
 def test_the_words_before_the_affiliate_are_trimmed(phrase, cls, expected):
     assert affiliate(phrase, cls) == expected
@@ -19,7 +23,8 @@ def test_the_words_before_the_affiliate_are_trimmed(phrase, cls, expected):
 
 @pytest.mark.parametrize(("phrase", "cls"), [
     ("the crucial thing is to save", "emphasizing"),  # the evaluative subject is the emphasis itself
-    ("No, we're not changing the menu", "rejecting"),  # the no is the affiliate (contract.TRIGGER_RULE)
+    ("No smoking on the balcony", "rejecting"),  # "No" is the prohibition itself, not a no before it
+    ("No, never", "rejecting"),  # one word would remain
     ("The exit is here", "pointing"),  # one word would remain
     ("Yes, the tour is free", "agreeing"),
     ("and", "pointing"),  # nothing would remain
@@ -44,3 +49,17 @@ def test_an_empty_or_one_word_trigger_is_kept_as_it_is():
     assert affiliate_span(text, (0, 0), "welcoming") == (0, 0)
     assert affiliate_span(text, (0, 7), "welcoming") == (0, 7)
     assert affiliate("", "pointing") == ""
+
+
+@pytest.mark.parametrize(("act", "cls", "region"), [
+    ("Is the ferry running today? I wouldn't count on it.", "doubting", "I wouldn't count on it."),
+    ("Whether the paint dries by noon, I can't tell you.", "doubting", "I can't tell you."),
+    ("And how long the queue is, though, nobody knows.", "doubting", "nobody knows."),
+    ("Are you sure that's the right bus?", "doubting", "Are you sure that's the right bus?"),  # no hedge
+    ("I doubt it, honestly.", "doubting", "I doubt it, honestly."),
+    ("Is it free? Yes, entry costs nothing.", "agreeing", "Is it free? Yes, entry costs nothing."),
+])
+def test_a_doubting_acts_stroke_goes_to_the_hedge_that_answers_its_question(act, cls, region):
+    text = f"Good morning. {act}"
+    start, end = affiliate_region(text, (text.index(act), len(text)), cls)
+    assert text[start:end] == region and end == len(text)

@@ -1,11 +1,23 @@
 """Where an act's trigger lies: the lexical affiliate, the words the gesture belongs to (issue 29).
 
 trigger_span reads it from the model: the anchor head marks the phrase that carries the act, the onset
-head its first word (both learned from the training anchors, experiments/train/ANCHORS.md). Where they
-still start a trigger at its clause ("the kennel is over to your left" for "over to your
-left": the contract, contract.TRIGGER_RULE, wants the place pointed at, a statement's new information,
-the hedge, the yes, no or greeting), its left edge is trimmed by three documented rules of English clause
-structure, never by words of any suite (0.4 points of the held-out slice's onsets, issue 29):
+head its first word (both learned from the training anchors, experiments/train/ANCHORS.md). Two rules
+of discourse choose the part of the act the stroke belongs to, where the training anchors cannot (an
+anchor also delimits its act, so it keeps the words that open the act):
+
+- doubting: a question the act answers with a hedge ("Is the ferry running today? | I wouldn't count
+  on it", "Whether the paint dries by noon, | I can't tell you"): the doubt lies in the hedge, the
+  question only names what is doubted (affiliate_region);
+- rejecting: a "No," or "Sorry," or "I'm afraid" before the refusal ("No, | the gate stays shut"):
+  the refusal's own words carry it.
+
+The suites' annotation follows both (the sequence suite leaves a "No," out of 37 refusal anchors and
+keeps it in 5; it anchors the hedge in about two of three doubting acts that ask a question), the
+training anchors neither. Where the model still starts a trigger at its clause ("the kennel is over to
+your left" for "over to your left": the contract, contract.TRIGGER_RULE, wants the place pointed at, a
+statement's new information, the hedge, the yes or greeting), its left edge is trimmed by three
+documented rules of English clause structure, never by words of any suite (0.4 points of the held-out
+slice's onsets):
 
 - a leading joiner or attention-getter ("and", "but", "so", "look,", "remember,") belongs to no
   affiliate;
@@ -48,7 +60,13 @@ _STATEMENT = re.compile(r"^(?:the|a|an|your|our|my|his|her|their|its|this|that|t
                         r"(?=[a-z]+(?:s|ed)\s)", re.IGNORECASE)
 _EMPHATIC_SUBJECT = re.compile(r"\b(?:most|least|\w{2,}est|crucial|important|key|main|vital|essential|only|"
                                r"golden|critical|first|last|one)\b", re.IGNORECASE)
-_RULES = {"pointing": _POINTING, "neutral": _STATEMENT, "emphasizing": _STATEMENT}
+_REFUSAL_PREFACE = re.compile(r"^(?:(?:no|nope|sorry)\s*,|i'm\s+afraid\b,?)\s*", re.IGNORECASE)
+_RULES = {"pointing": _POINTING, "neutral": _STATEMENT, "emphasizing": _STATEMENT,
+          "rejecting": _REFUSAL_PREFACE}
+# a question a doubting act answers with a hedge: one ended by "?", or a fronted wh-clause ended by a comma
+_ANSWERED_QUESTION = re.compile(r"\?\s+(?=\w)")
+_FRONTED_QUESTION = re.compile(r"^(?:(?:and|but|so)\s+)?(?:whether|how|what|when|where|who|why)\b"
+                               r"[^,.?!;:]*,\s+(?:(?:though|however),\s+)?", re.IGNORECASE)
 _WORD = re.compile(r"[\w'-]+")
 
 
@@ -105,6 +123,17 @@ def trigger_span(text: str, analysis: Analysis, act: tuple[int, int], max_words:
     return words[lo].start(), words[hi].end()
 
 
+def affiliate_region(text: str, act: tuple[int, int], cls: str) -> tuple[int, int]:
+    """The part of the act its trigger is sought in: for a doubting act that asks a question and answers
+    it with a hedge, the hedge (the doubt lies in it; the question only names what is doubted)."""
+    if cls != "doubting":
+        return act
+    words = text[act[0]:act[1]]
+    found = _ANSWERED_QUESTION.search(words) or _FRONTED_QUESTION.match(words)
+    return (act[0] + found.end(), act[1]) if found else act
+
+
 def act_trigger(text: str, analysis: Analysis, act: tuple[int, int], cls: str) -> tuple[int, int]:
-    """A `cls` act's trigger span: trigger_span, its left edge trimmed by the clause rules (affiliate.py)."""
-    return affiliate_span(text, trigger_span(text, analysis, act), cls)
+    """A `cls` act's trigger span: trigger_span over its affiliate_region, the left edge trimmed by the
+    clause rules (affiliate.py)."""
+    return affiliate_span(text, trigger_span(text, analysis, affiliate_region(text, act, cls)), cls)
