@@ -38,4 +38,5 @@ def test_the_guide_quotes_no_suite_anchor():
 
 
 def _words(text: str) -> str:
-    return re.sub(r"[^\w' ]", "", text.lower()).strip()
+    """Lower case, punctuation dropped, every run of whitespace (a quote wrapped over lines) one space."""
+    return " ".join(re.sub(r"[^\w'\s]", "", text.lower()).split())
