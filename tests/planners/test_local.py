@@ -205,17 +205,16 @@ def test_quality_floor_on_held_out_training_slice(planner):
     metrics = held_out_metrics(planner, utterances, [planner.score(e.text) for e in utterances])
     dialogues = [e for e in held_out if e.history]
     metrics.update(context_metrics(planner, dialogues, scored_dialogues(planner, dialogues)))
-    # Measured (seeded, `+experiment=train_local`): single top-1 88.7 %, sequence exact 63.6 %, anchor
-    # recall 85.0 %, exact variant 47.8 %, dialogues 84.4 % with history, 73.0 % without (seed 0; seeds 1
-    # and 2 give 52.5 / 49.9 % exact variant and 87.2 / 87.7 % dialogues). Floors leave about 3 points for
-    # training on another CPU (bfloat16 support and thread counts change the sums); the history must still
-    # add at least five points (a plain answer needs no history to read neutral).
+    # Measured (seeded, `+experiment=train_local`): single top-1 86.3 %, sequence exact 63.2 %, anchor
+    # recall 86.4 %, exact variant 50.6 %, dialogues 87.7 % with history, 78.2 % without. Floors leave
+    # about 3 points for training on another CPU (bfloat16 support and thread counts change the sums);
+    # the history must still add at least five points (a plain answer needs no history to read neutral).
     assert metrics["singles"] > 250 and metrics["sequences"] >= 200 and metrics["dialogues"] >= 150
-    assert metrics["single_top1"] >= 0.85, metrics
-    assert metrics["sequence_exact"] >= 0.60, metrics
-    assert metrics["anchor_recall"] >= 0.82, metrics
-    assert metrics["exact_variant"] >= 0.44, metrics
-    assert metrics["context_with_history"] >= 0.81, metrics
+    assert metrics["single_top1"] >= 0.84, metrics
+    assert metrics["sequence_exact"] >= 0.58, metrics
+    assert metrics["anchor_recall"] >= 0.81, metrics
+    assert metrics["exact_variant"] >= 0.49, metrics
+    assert metrics["context_with_history"] >= 0.83, metrics
     assert metrics["context_with_history"] >= metrics["context_without"] + 0.05, metrics
 
 
