@@ -45,9 +45,10 @@ MAX_REPLY_CHARS = 200
 # What a record's trigger is (README "The planner's contract"; the schema's description says it to a model)
 TRIGGER_RULE = ("the words the gesture belongs to (its lexical affiliate: the place pointed at, the stressed "
                 "words, the yes or greeting itself, a refusal's own words after any 'No,' before them, a "
-                "doubt's hedge rather than the question it answers), 1-6 words copied exactly from the "
-                "reply; its first word is where the stroke lands, so it starts there, not at the clause "
-                "around it")
+                "doubt's hedge rather than the question it answers, the reassurance itself rather than a "
+                "'Don't worry,' before it, never an 'Oh,' or a name called before the words), 1-6 words "
+                "copied exactly from the reply; its first word is where the stroke lands, so it starts "
+                "there, not at the clause around it")
 
 
 class EventKind(StrEnum):

@@ -16,6 +16,14 @@ from emopose.planners.local.affiliate import affiliate, affiliate_region, affili
     ("but no, I won't sign it", "rejecting", "I won't sign it"),
     ("Sorry, strollers stay downstairs", "rejecting", "strollers stay downstairs"),
     ("I'm afraid the roof is off limits", "rejecting", "the roof is off limits"),
+    ("Oh, Mr. Lowe, please take a seat", "welcoming", "please take a seat"),  # interjection and name
+    ("Aw, don't be glum", "comforting", "don't be glum"),
+    ("I can see the delay is bothering you", "comforting", "the delay is bothering you"),
+    ("Don't worry, your bag is safe here", "comforting", "your bag is safe here"),
+    ("It's alright, plenty of people miss that step", "comforting", "plenty of people miss that step"),
+    ("There's no rush at all", "comforting", "no rush at all"),
+    ("Whatever happens, we'll be right here", "comforting", "we'll be right here"),
+    ("Label every sample first; that's essential", "emphasizing", "that's essential"),  # the evaluating tag
 ])
 def test_the_words_before_the_affiliate_are_trimmed(phrase, cls, expected):
     assert affiliate(phrase, cls) == expected
@@ -27,6 +35,12 @@ def test_the_words_before_the_affiliate_are_trimmed(phrase, cls, expected):
     ("No, never", "rejecting"),  # one word would remain
     ("The exit is here", "pointing"),  # one word would remain
     ("Yes, the tour is free", "agreeing"),
+    ("Oh, hello there", "welcoming"),  # the interjection belongs to the greeting
+    ("Ah, yes, that's correct", "agreeing"),  # an agreeing or doubting act keeps its interjection
+    ("Hmm, I doubt it", "doubting"),
+    ("I know it's been a long day", "comforting"),  # "I know" is kept (the module docstring says why)
+    ("Don't worry, honestly", "comforting"),  # one word would remain
+    ("Oh, Grace", "comforting"),
     ("and", "pointing"),  # nothing would remain
 ])
 def test_an_affiliate_it_is_unsure_of_stays_whole(phrase, cls):

@@ -15,19 +15,30 @@ The suites' annotation follows both (the sequence suite leaves a "No," out of 37
 keeps it in 5; it anchors the hedge in about two of three doubting acts that ask a question), the
 training anchors neither. Where the model still starts a trigger at its clause ("the kennel is over to
 your left" for "over to your left": the contract, contract.TRIGGER_RULE, wants the place pointed at, a
-statement's new information, the hedge, the yes or greeting), its left edge is trimmed by three
-documented rules of English clause structure, never by words of any suite (0.4 points of the held-out
-slice's onsets):
+statement's new information, the hedge, the yes or greeting, the reassurance itself), its left edge is
+trimmed by documented rules of English clause structure and discourse, never by words of any suite:
 
 - a leading joiner or attention-getter ("and", "but", "so", "look,", "remember,") belongs to no
   affiliate;
+- an interjection and the name it calls ("Oh, Ms. Ito, | please join us", "Aw, | don't be sad"), except
+  in agreeing and doubting acts (where "ah, yes" or "hmm" is the act) and before a greeting ("Oh, hello
+  there" keeps it);
 - pointing: the subject and its verb before the place ("the kennel is | over to your left", "your
   coat's | on the hook"): a pointing gesture's affiliate is the locative or deictic phrase;
 - neutral and emphasizing: a short subject before a copula and the predicate it introduces ("The retake
   is | on the 9th"), or before a verb ending in -s/-ed ("The exhibition | closes at six"): the new
   information carries the stress (the nuclear accent falls late in the English clause); but an
   emphasizing subject that is itself the emphasis (a superlative or an evaluative adjective: "the
-  crucial thing is", "the biggest danger is") keeps it.
+  crucial thing is", "the biggest danger is") keeps it;
+- emphasizing: a clause before a tag that evaluates it ("Get it in writing; | that's vital");
+- comforting: what leads into the reassurance rather than saying it: "I can see/tell/hear (that)", a
+  formula before a comma ("Don't worry, | we'll find it", "It's alright, | lots of people ...",
+  "Whatever happens,"), an existential "There's" before "no"/"nothing". "I know ..." stays: annotators
+  keep it about as often as they leave it out.
+
+These rules were kept where they raised the held-out training slice's onsets (seed 0: 65.1 -> 66.0 %;
+the sequence suite's 70.8 -> 73.3 %); trimming "I know", a "please" before a prohibition, or a pointing
+phrase down to its "on the left" was not kept: the held-out slice lost by each.
 
 A trim that would leave fewer than two words keeps the trigger whole, and so does one whose shorter text
 occurs earlier in the reply (the schedule finds a trigger at its first occurrence, contract.py).
@@ -61,8 +72,22 @@ _STATEMENT = re.compile(r"^(?:the|a|an|your|our|my|his|her|their|its|this|that|t
 _EMPHATIC_SUBJECT = re.compile(r"\b(?:most|least|\w{2,}est|crucial|important|key|main|vital|essential|only|"
                                r"golden|critical|first|last|one)\b", re.IGNORECASE)
 _REFUSAL_PREFACE = re.compile(r"^(?:(?:no|nope|sorry)\s*,|i'm\s+afraid\b,?)\s*", re.IGNORECASE)
-_RULES = {"pointing": _POINTING, "neutral": _STATEMENT, "emphasizing": _STATEMENT,
-          "rejecting": _REFUSAL_PREFACE}
+# an interjection, and the name it calls, before the act's own words ("Oh, Ms. Ito, | please join us"); not
+# before a greeting, which the interjection is part of ("Oh, hello there")
+_NO_GREETING = r"(?!\s*(?:hi|hello|hey|hiya|howdy|good\s+(?:morning|afternoon|evening))\b)"
+_INTERJECTION = re.compile(rf"^(?:oh(?:\s+(?:no|dear))?|ah|aw|ooh|hey|ouch)\s*,\s*{_NO_GREETING}"
+                           rf"(?:(?:(?:mr|mrs|ms|dr)\.?\s+)?(?-i:[A-Z])[\w'-]*\s*,\s*{_NO_GREETING})?",
+                           re.IGNORECASE)
+# comforting: what introduces the reassurance or the sympathy rather than saying it ("I can see | this is
+# weighing on you", "Don't worry, | we'll find it", "There's | no need to apologise")
+_COMFORT_LEAD_IN = re.compile(r"^i\s+can\s+(?:see|tell|hear)(?:\s+that)?\s*,?\s+"
+                              r"|^(?:don't\s+(?:worry|fret|panic)|it's\s+(?:okay|ok|alright|all\s+right)|there|"
+                              r"easy\s+now|whatever\s+happens)\s*,\s+"
+                              r"|^there's\s+(?=(?:no|nothing)\b)", re.IGNORECASE)
+# emphasizing: a clause before the tag that evaluates it ("Get everything in writing; | that's vital")
+_EVALUATIVE_TAG = re.compile(r"^.*?[,;:]\s+(?=that's\b)", re.IGNORECASE)
+_RULES = {"pointing": [_POINTING], "neutral": [_STATEMENT], "emphasizing": [_STATEMENT, _EVALUATIVE_TAG],
+          "rejecting": [_REFUSAL_PREFACE], "comforting": [_COMFORT_LEAD_IN]}
 # a question a doubting act answers with a hedge: one ended by "?", or a fronted wh-clause ended by a comma
 _ANSWERED_QUESTION = re.compile(r"\?\s+(?=\w)")
 _FRONTED_QUESTION = re.compile(r"^(?:(?:and|but|so)\s+)?(?:whether|how|what|when|where|who|why)\b"
@@ -73,12 +98,14 @@ _WORD = re.compile(r"[\w'-]+")
 def affiliate(phrase: str, cls: str) -> str:
     """The phrase without what precedes its affiliate (the module docstring's rules): a suffix of it."""
     trimmed = _JOINER.sub("", phrase, count=1)
-    rule = _RULES.get(cls)
-    if rule is not None and (match := rule.match(trimmed)):
-        rest = trimmed[match.end():]
-        emphatic = cls == "emphasizing" and _EMPHATIC_SUBJECT.search(trimmed[:match.end()])
-        if len(_WORD.findall(rest)) >= 2 and not emphatic:
-            trimmed = rest
+    rules = ([] if cls in ("agreeing", "doubting") else [_INTERJECTION]) + _RULES.get(cls, [])
+    for rule in rules:
+        if match := rule.match(trimmed):
+            rest = trimmed[match.end():]
+            lead = trimmed[:match.end()]
+            emphatic = rule is _STATEMENT and cls == "emphasizing" and _EMPHATIC_SUBJECT.search(lead)
+            if len(_WORD.findall(rest)) >= 2 and not emphatic:
+                trimmed = rest
     return trimmed if _WORD.search(trimmed) else phrase
 
 
