@@ -21,7 +21,7 @@ from emopose.planners.local.affiliate import affiliate, affiliate_region, affili
     ("I can see the delay is bothering you", "comforting", "the delay is bothering you"),
     ("Don't worry, your bag is safe here", "comforting", "your bag is safe here"),
     ("It's alright, plenty of people miss that step", "comforting", "plenty of people miss that step"),
-    ("There's no rush at all", "comforting", "no rush at all"),
+    ("There's no hurry whatsoever", "comforting", "no hurry whatsoever"),
     ("Whatever happens, we'll be right here", "comforting", "we'll be right here"),
     ("Label every sample first; that's essential", "emphasizing", "that's essential"),  # the evaluating tag
 ])

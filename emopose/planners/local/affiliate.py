@@ -20,7 +20,7 @@ trimmed by documented rules of English clause structure and discourse, never by 
 
 - a leading joiner or attention-getter ("and", "but", "so", "look,", "remember,") belongs to no
   affiliate;
-- an interjection and the name it calls ("Oh, Ms. Ito, | please join us", "Aw, | don't be sad"), except
+- an interjection and the name it calls ("Oh, Mr. Lowe, | please take a seat", "Aw, | don't be glum"), except
   in agreeing and doubting acts (where "ah, yes" or "hmm" is the act) and before a greeting ("Oh, hello
   there" keeps it);
 - pointing: the subject and its verb before the place ("the kennel is | over to your left", "your
@@ -30,9 +30,9 @@ trimmed by documented rules of English clause structure and discourse, never by 
   information carries the stress (the nuclear accent falls late in the English clause); but an
   emphasizing subject that is itself the emphasis (a superlative or an evaluative adjective: "the
   crucial thing is", "the biggest danger is") keeps it;
-- emphasizing: a clause before a tag that evaluates it ("Get it in writing; | that's vital");
+- emphasizing: a clause before a tag that evaluates it ("Label every sample first; | that's essential");
 - comforting: what leads into the reassurance rather than saying it: "I can see/tell/hear (that)", a
-  formula before a comma ("Don't worry, | we'll find it", "It's alright, | lots of people ...",
+  formula before a comma ("Don't worry, | your bag is safe here", "It's alright, | plenty of people ...",
   "Whatever happens,"), an existential "There's" before "no"/"nothing". "I know ..." stays: annotators
   keep it about as often as they leave it out.
 
@@ -72,19 +72,19 @@ _STATEMENT = re.compile(r"^(?:the|a|an|your|our|my|his|her|their|its|this|that|t
 _EMPHATIC_SUBJECT = re.compile(r"\b(?:most|least|\w{2,}est|crucial|important|key|main|vital|essential|only|"
                                r"golden|critical|first|last|one)\b", re.IGNORECASE)
 _REFUSAL_PREFACE = re.compile(r"^(?:(?:no|nope|sorry)\s*,|i'm\s+afraid\b,?)\s*", re.IGNORECASE)
-# an interjection, and the name it calls, before the act's own words ("Oh, Ms. Ito, | please join us"); not
-# before a greeting, which the interjection is part of ("Oh, hello there")
+# an interjection, and the name it calls, before the act's own words ("Oh, Mr. Lowe, | please take a
+# seat"); not before a greeting, which the interjection is part of ("Oh, hello there")
 _NO_GREETING = r"(?!\s*(?:hi|hello|hey|hiya|howdy|good\s+(?:morning|afternoon|evening))\b)"
 _INTERJECTION = re.compile(rf"^(?:oh(?:\s+(?:no|dear))?|ah|aw|ooh|hey|ouch)\s*,\s*{_NO_GREETING}"
                            rf"(?:(?:(?:mr|mrs|ms|dr)\.?\s+)?(?-i:[A-Z])[\w'-]*\s*,\s*{_NO_GREETING})?",
                            re.IGNORECASE)
-# comforting: what introduces the reassurance or the sympathy rather than saying it ("I can see | this is
-# weighing on you", "Don't worry, | we'll find it", "There's | no need to apologise")
+# comforting: what introduces the reassurance or the sympathy rather than saying it ("I can see | the delay is
+# bothering you", "Don't worry, | your bag is safe here", "There's | no hurry whatsoever")
 _COMFORT_LEAD_IN = re.compile(r"^i\s+can\s+(?:see|tell|hear)(?:\s+that)?\s*,?\s+"
                               r"|^(?:don't\s+(?:worry|fret|panic)|it's\s+(?:okay|ok|alright|all\s+right)|there|"
                               r"easy\s+now|whatever\s+happens)\s*,\s+"
                               r"|^there's\s+(?=(?:no|nothing)\b)", re.IGNORECASE)
-# emphasizing: a clause before the tag that evaluates it ("Get everything in writing; | that's vital")
+# emphasizing: a clause before the tag that evaluates it ("Label every sample first; | that's essential")
 _EVALUATIVE_TAG = re.compile(r"^.*?[,;:]\s+(?=that's\b)", re.IGNORECASE)
 _RULES = {"pointing": [_POINTING], "neutral": [_STATEMENT], "emphasizing": [_STATEMENT, _EVALUATIVE_TAG],
           "rejecting": [_REFUSAL_PREFACE], "comforting": [_COMFORT_LEAD_IN]}
