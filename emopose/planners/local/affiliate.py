@@ -89,8 +89,11 @@ _COMFORT_LEAD_IN = re.compile(r"^i\s+can\s+(?:see|tell|hear)(?:\s+that)?\s*,?\s+
                               r"|^there's\s+(?=(?:no|nothing)\b)", re.IGNORECASE)
 # emphasizing: a clause before the tag that evaluates it ("Label every sample first; | that's essential")
 _EVALUATIVE_TAG = re.compile(r"^.*?[,;:]\s+(?=that's\b)", re.IGNORECASE)
-_RULES = {"pointing": [_POINTING], "neutral": [_STATEMENT], "emphasizing": [_STATEMENT, _EVALUATIVE_TAG],
-          "rejecting": [_REFUSAL_PREFACE], "comforting": [_COMFORT_LEAD_IN]}
+# the rules of each class, in order; agreeing and doubting have none ("ah, yes" or "hmm" is the act itself)
+_RULES = {"pointing": [_INTERJECTION, _POINTING], "neutral": [_INTERJECTION, _STATEMENT],
+          "emphasizing": [_INTERJECTION, _STATEMENT, _EVALUATIVE_TAG],
+          "rejecting": [_INTERJECTION, _REFUSAL_PREFACE], "comforting": [_INTERJECTION, _COMFORT_LEAD_IN],
+          "welcoming": [_INTERJECTION]}
 # a question a doubting act answers with a hedge: one ended by "?", or a fronted wh-clause ended by a comma
 _ANSWERED_QUESTION = re.compile(r"\?\s+(?=\w)")
 _FRONTED_QUESTION = re.compile(r"^(?:(?:and|but|so)\s+)?(?:whether|how|what|when|where|who|why)\b"
@@ -101,12 +104,11 @@ _WORD = re.compile(r"[\w'-]+")
 def affiliate(phrase: str, cls: str) -> str:
     """The phrase without what precedes its affiliate (the module docstring's rules): a suffix of it."""
     trimmed = _JOINER.sub("", phrase, count=1)
-    rules = ([] if cls in ("agreeing", "doubting") else [_INTERJECTION]) + _RULES.get(cls, [])
-    for rule in rules:
+    for rule in _RULES.get(cls, []):
         if match := rule.match(trimmed):
             rest = trimmed[match.end():]
-            lead = trimmed[:match.end()]
-            emphatic = rule is _STATEMENT and cls == "emphasizing" and _EMPHATIC_SUBJECT.search(lead)
+            emphatic = (rule is _STATEMENT and cls == "emphasizing"
+                        and _EMPHATIC_SUBJECT.search(trimmed[:match.end()]))
             if len(_WORD.findall(rest)) >= 2 and not emphatic:
                 trimmed = rest
     return trimmed if _WORD.search(trimmed) else phrase
