@@ -7,6 +7,9 @@ to /api/say one at a time (each waiting until the robot is idle again), stops th
 and reads its session.mcap and results.json:
   strokes       share within [-200, +100] ms of the trigger onset on the command stream and on the
                 simulated joints, median |offset|, dropped share (emopose.sync.strokes.stroke_summary)
+  gold anchors  the same executed strokes against the onsets of the suite's annotated anchors (the words
+                each gesture belongs to; an anchor without a gesture counts as missed), as sync_eval's
+                stroke-vs-gold-anchor: what a listener sees, the planner's triggers included
   loop          missed deadlines / ticks, stalls, lateness (results.json) and the largest gap between
                 two recorded commands (/joints/command)
   latency       request -> speech start and request -> first executed stroke, median and p95
@@ -42,7 +45,7 @@ sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 from emopose.joint_limits import JointLimits
 from emopose.recording import read_recording
 from emopose.sync.joint_bounds import joint_bounds
-from emopose.sync.recording import read_stroke_sync
+from emopose.sync.recording import read_gold_anchor_sync, read_stroke_sync
 from emopose.sync.strokes import stroke_summary
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -195,12 +198,16 @@ def measure(args: argparse.Namespace, run_dir: Path) -> dict:
             server.send_signal(signal.SIGTERM)
             server.wait(timeout=120)
     rows = read_stroke_sync(run_dir / "session.mcap")
+    gold, unspoken = read_gold_anchor_sync(run_dir / "session.mcap",
+                                           [(item["text"], item["anchors"]) for item in items])
     results = json.loads((run_dir / "results.json").read_text())
     loop = results["loop"]
     return {"command": " ".join(serve_command(port, run_dir, args.extra)[1:]), "items": len(items),
             "busy": args.busy, "pages": args.pages, "driven_s": round(driven_s, 1),
             "strokes_commands": stroke_summary(rows),
             "strokes_simulated": stroke_summary(rows, simulated=True),
+            "strokes_gold_anchor_commands": stroke_summary(gold) | {"anchors_not_spoken": unspoken},
+            "strokes_gold_anchor_simulated": stroke_summary(gold, simulated=True),
             "loop": {**loop, **command_gaps(run_dir / "session.mcap")},
             "simulated_joints": simulated_joint_bounds(run_dir / "session.mcap"), **latencies(turns)}
 

@@ -6,11 +6,14 @@ Two channels, on the recording's session clock like every time in it (the `t` of
                      duration, each word's onset and text span, and per planned gesture its command,
                      stroke-start keyframe, trigger onset, planned and executed stroke arrival (s from
                      speech start) and drop reason.
-`read_stroke_sync(path)` rebuilds the streams and runs the same measurement as sync_eval.
+`read_stroke_sync(path)` rebuilds the streams and runs the same measurement as sync_eval;
+`read_gold_anchor_sync(path, items)` measures the same executed strokes against annotated anchors of the
+texts that were spoken (sync_eval's stroke-vs-gold-anchor, for a served session driven with suite texts).
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +21,10 @@ import numpy as np
 from emopose import STROKE_TOLERANCE
 from emopose.contract import EventKind, trigger_position
 from emopose.recording import read_recording
+from emopose.speech.espeak_lib import WordEvent
+from emopose.sync.affiliate import gold_anchor_strokes
 from emopose.sync.strokes import PlannedStroke, Streams, StrokeSync, measure_strokes, planned_strokes
+from emopose.sync.words import annotated_spans
 
 EVENTS, TIMELINE = "/sequencer/events", "/speech/timeline"
 
@@ -52,6 +58,44 @@ def speech_timeline(turn) -> dict:
 
 def read_stroke_sync(path: str | Path, tolerance: float = STROKE_TOLERANCE) -> list[StrokeSync]:
     """Every recorded turn's strokes against their words' onsets, from the MCAP alone."""
+    return [row for _, _, rows in recorded_turns(path, tolerance) for row in rows]
+
+
+def read_gold_anchor_sync(path: str | Path, items: Sequence[tuple[str, Sequence[str]]],
+                          tolerance: float = STROKE_TOLERANCE) -> tuple[list[StrokeSync], int]:
+    """The recorded strokes against the annotated anchors of the texts spoken, in the order they were
+    spoken (items: (text, anchors)); a turn is one item's whole text or one sentence of it. Returns the
+    per-anchor rows (as sync_eval's stroke-vs-gold-anchor: an anchor without a gesture counts as not
+    arrived; one that is not in its own text is left out) and how many anchors were not in any recorded
+    turn (a text not spoken, or spoken changed)."""
+    rows, unspoken, queue = [], 0, iter(items)
+    current = None  # (text, anchor spans not yet assigned, search cursor)
+    for name, turn, strokes in recorded_turns(path, tolerance):
+        said = turn["text"]
+        start = -1 if current is None else current[0].find(said, current[2])
+        while start < 0:  # the turn starts the next item: the anchors left of the last one were not said
+            unspoken += 0 if current is None else sum(span is not None for span in current[1])
+            text, anchors = next(queue, (None, ()))
+            if text is None:
+                raise ValueError(f"{path}: a recorded turn matches no item left: {said[:60]!r}")
+            current = (text, annotated_spans(text, tuple(anchors)), 0)
+            start = text.find(said)
+        text, spans, _ = current
+        end = start + len(said)
+        inside = [(a - start, b - start) for a, b in (s for s in spans if s is not None) if start <= a < end]
+        current = (text, [s for s in spans if s is None or not start <= s[0] < end], end)
+        events = [WordEvent(w["char_start"], w["char_end"] - w["char_start"], w["start_s"])
+                  for w in turn["words"]]
+        rows += gold_anchor_strokes(name, said, inside,
+                                    [g["trigger"] for g in turn["gestures"]], strokes, events)
+    if current is not None:
+        unspoken += sum(span is not None for span in current[1])
+    return rows, unspoken + sum(len(anchors) for _, anchors in queue)
+
+
+def recorded_turns(path: str | Path,
+                   tolerance: float = STROKE_TOLERANCE) -> Iterator[tuple[str, dict, list[StrokeSync]]]:
+    """Each recorded /speech/timeline turn: its name ("turn-N"), message and gestures' measured strokes."""
     topics = read_recording(path)
     if TIMELINE not in topics:
         raise ValueError(f"{path}: no {TIMELINE} channel (recorded before stroke-sync recording existed?)")
@@ -60,13 +104,12 @@ def read_stroke_sync(path: str | Path, tolerance: float = STROKE_TOLERANCE) -> l
     q = np.array([m["q"] for _, m in commands])
     sim = topics.get("/joints/sim")
     events = [(m["t"], m["kind"], m["command_id"]) for _, m in topics.get(EVENTS, [])]
-    rows = []
     for number, (_, turn) in enumerate(topics[TIMELINE]):
         planned = [PlannedStroke(g["k"], g["motion"], g["command_id"], np.asarray(g["keyframe"]),
                                  g["planned_s"], g["dropped"]) for g in turn["gestures"]]
         streams = Streams(events, turn["speech_start"], times, q,
                           None if sim is None else np.array([m["t"] for _, m in sim]),
                           None if sim is None else np.array([m["q"] for _, m in sim]))
-        rows += measure_strokes(f"turn-{number}", planned, [g["onset_s"] for g in turn["gestures"]], streams,
-                                turn["preroll_s"], tolerance)
-    return rows
+        name = f"turn-{number}"
+        yield name, turn, measure_strokes(name, planned, [g["onset_s"] for g in turn["gestures"]], streams,
+                                          turn["preroll_s"], tolerance)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from pathlib import Path
 
 import pytest
 
@@ -12,7 +13,8 @@ from emopose.bench.suites import load_sequence
 from emopose.build import build_run, make
 from emopose.config import project_path
 from emopose.jobs.sync_eval import SyncEvalJob
-from emopose.sync.recording import read_stroke_sync
+from emopose.sync.recording import read_gold_anchor_sync, read_stroke_sync
+from emopose.sync.strokes import stroke_summary
 from emopose.sync.words import true_word_events
 from tests.conftest import synthetic_library
 
@@ -52,6 +54,19 @@ def test_the_timeline_lands_strokes_on_their_words_and_the_recording_measures_it
         assert (again.executed_s is None) == (row["executed_s"] is None)
         if row["executed_s"] is not None:
             assert again.executed_s == pytest.approx(row["executed_s"], abs=1e-6)
+    # and, given the texts spoken and their anchors, the same strokes against the gold anchors
+    lines = Path(FIXTURE_SUITE).read_text().splitlines()
+    items = [(item["text"], item["anchors"]) for item in map(json.loads, lines)]
+    gold, unspoken = read_gold_anchor_sync(tmp_path / "run" / "session.mcap", items * 3)
+    assert unspoken == 0 and len(gold) == 3 * 16  # sync-fix-08's second anchor is not in its text
+    for n, mode in enumerate(("anchor", "words", "timeline")):
+        again = stroke_summary(gold[n * 16:(n + 1) * 16])
+        live = results["modes"][mode]["stroke_vs_gold_anchor"]
+        assert again["n"] == live["n"] and again["arrived"] == live["arrived"]
+        assert again["within_window_share"] == pytest.approx(live["within_window_share"])
+        assert again["median_abs_ms"] == pytest.approx(live["median_abs_ms"], abs=1e-3)
+    with pytest.raises(ValueError, match="matches no item left"):
+        read_gold_anchor_sync(tmp_path / "run" / "session.mcap", items[:2])
 
 
 def test_sync_eval_falls_back_to_the_fixture_and_needs_true_word_events(tmp_path, compose):
