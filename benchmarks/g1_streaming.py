@@ -26,6 +26,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from g1_publish import start_fake  # noqa: E402
 from live_serve import ROOT, busy_cores, command_gaps  # noqa: E402
 
+from emopose.recording import read_recording  # noqa: E402
+
 TEXTS = ("Welcome! The workshop is through that door on the left.",
          "I'm so sorry, the café closed an hour ago, but the vending machines are just behind you.",
          "Absolutely, take as many leaflets as you like, they are free.",
@@ -51,7 +53,7 @@ def one_run(domain_id: int, planner: str, text: str, folder: Path) -> dict:
     return {"exit": done.returncode, "wall_s": round(time.monotonic() - started, 1), "fault": fault,
             "deadman": bool(fault and fault.startswith("deadman")),
             "missed_deadlines": loop.get("missed_deadlines"), "ticks": loop.get("ticks"),
-            **(command_gaps(mcap) if mcap.exists() else {}),
+            **(command_gaps(read_recording(mcap)) if mcap.exists() else {}),
             **({} if done.returncode == 0 else {"stderr_tail": done.stderr[-400:]})}
 
 

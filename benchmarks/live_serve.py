@@ -157,16 +157,16 @@ def latencies(turns: list[dict]) -> dict:
     return {"request_to_speech": percentiles(to_speech), "request_to_first_stroke": percentiles(to_stroke)}
 
 
-def command_gaps(mcap: Path) -> dict:
-    times = np.array([m["t"] for _, m in read_recording(mcap).get("/joints/command", [])])
+def command_gaps(topics: dict) -> dict:
+    times = np.array([m["t"] for _, m in topics.get("/joints/command", [])])
     gaps = np.diff(times) * 1e3 if times.size > 1 else np.zeros(1)
     gaps = np.round(gaps, 3)  # stream times are multiples of 20 ms up to float error
     return {"max_command_gap_ms": float(gaps.max()), "gaps_over_40ms": int(np.sum(gaps > 40)),
             "gaps_over_60ms": int(np.sum(gaps > 60))}
 
 
-def simulated_joint_bounds(mcap: Path) -> dict:
-    rows = read_recording(mcap).get("/joints/sim", [])
+def simulated_joint_bounds(topics: dict) -> dict:
+    rows = topics.get("/joints/sim", [])
     times = np.array([m["t"] for _, m in rows])
     q = np.array([m["q"] for _, m in rows])
     return joint_bounds(times, q, JointLimits.from_file(LIMITS))
@@ -197,9 +197,9 @@ def measure(args: argparse.Namespace, run_dir: Path) -> dict:
             stop_pages.set()
             server.send_signal(signal.SIGTERM)
             server.wait(timeout=120)
-    rows = read_stroke_sync(run_dir / "session.mcap")
-    gold, unspoken = read_gold_anchor_sync(run_dir / "session.mcap",
-                                           [(item["text"], item["anchors"]) for item in items])
+    topics = read_recording(run_dir / "session.mcap")  # once: a long session's file takes minutes
+    rows = read_stroke_sync(topics)
+    gold, unspoken = read_gold_anchor_sync(topics, [(item["text"], item["anchors"]) for item in items])
     results = json.loads((run_dir / "results.json").read_text())
     loop = results["loop"]
     return {"command": " ".join(serve_command(port, run_dir, args.extra)[1:]), "items": len(items),
@@ -208,8 +208,8 @@ def measure(args: argparse.Namespace, run_dir: Path) -> dict:
             "strokes_simulated": stroke_summary(rows, simulated=True),
             "strokes_gold_anchor_commands": stroke_summary(gold) | {"anchors_not_spoken": unspoken},
             "strokes_gold_anchor_simulated": stroke_summary(gold, simulated=True),
-            "loop": {**loop, **command_gaps(run_dir / "session.mcap")},
-            "simulated_joints": simulated_joint_bounds(run_dir / "session.mcap"), **latencies(turns)}
+            "loop": {**loop, **command_gaps(topics)},
+            "simulated_joints": simulated_joint_bounds(topics), **latencies(turns)}
 
 
 def main() -> None:

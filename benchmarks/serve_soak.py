@@ -101,7 +101,7 @@ def loop_health(results: dict, mcap: Path) -> dict:
     loop = results.get("loop") or {}
     kept = ("ticks", "missed_deadlines", "missed_per_tick", "stalls", "lateness_ms_p99", "lateness_ms_max",
             "scheduling")
-    return {**{key: loop[key] for key in kept if key in loop}, **command_gaps(mcap)}
+    return {**{key: loop[key] for key in kept if key in loop}, **command_gaps(read_recording(mcap))}
 
 
 def check(value: float, bound: float, passed: bool) -> dict:

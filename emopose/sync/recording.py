@@ -6,9 +6,11 @@ Two channels, on the recording's session clock like every time in it (the `t` of
                      duration, each word's onset and text span, and per planned gesture its command,
                      stroke-start keyframe, trigger onset, planned and executed stroke arrival (s from
                      speech start) and drop reason.
-`read_stroke_sync(path)` rebuilds the streams and runs the same measurement as sync_eval;
-`read_gold_anchor_sync(path, items)` measures the same executed strokes against annotated anchors of the
-texts that were spoken (sync_eval's stroke-vs-gold-anchor, for a served session driven with suite texts).
+`read_stroke_sync(recording)` rebuilds the streams and runs the same measurement as sync_eval;
+`read_gold_anchor_sync(recording, items)` measures the same executed strokes against annotated anchors of
+the texts that were spoken (sync_eval's stroke-vs-gold-anchor, for a served session driven with suite
+texts). A recording is the MCAP's path or what read_recording gave for it (a long session's file takes
+minutes to decode: read it once).
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ from emopose.speech.espeak_lib import WordEvent
 from emopose.sync.affiliate import gold_anchor_strokes
 from emopose.sync.strokes import PlannedStroke, Streams, StrokeSync, measure_strokes, planned_strokes
 from emopose.sync.words import annotated_spans
+
+Recording = str | Path | dict  # an MCAP path, or the topics read_recording gave for it
 
 EVENTS, TIMELINE = "/sequencer/events", "/speech/timeline"
 
@@ -56,12 +60,12 @@ def speech_timeline(turn) -> dict:
             "gestures": gestures}
 
 
-def read_stroke_sync(path: str | Path, tolerance: float = STROKE_TOLERANCE) -> list[StrokeSync]:
+def read_stroke_sync(recording: Recording, tolerance: float = STROKE_TOLERANCE) -> list[StrokeSync]:
     """Every recorded turn's strokes against their words' onsets, from the MCAP alone."""
-    return [row for _, _, rows in recorded_turns(path, tolerance) for row in rows]
+    return [row for _, _, rows in recorded_turns(recording, tolerance) for row in rows]
 
 
-def read_gold_anchor_sync(path: str | Path, items: Sequence[tuple[str, Sequence[str]]],
+def read_gold_anchor_sync(recording: Recording, items: Sequence[tuple[str, Sequence[str]]],
                           tolerance: float = STROKE_TOLERANCE) -> tuple[list[StrokeSync], int]:
     """The recorded strokes against the annotated anchors of the texts spoken, in the order they were
     spoken (items: (text, anchors)); a turn is one item's whole text or one sentence of it. Returns the
@@ -70,14 +74,14 @@ def read_gold_anchor_sync(path: str | Path, items: Sequence[tuple[str, Sequence[
     turn (a text not spoken, or spoken changed)."""
     rows, unspoken, queue = [], 0, iter(items)
     current = None  # (text, anchor spans not yet assigned, search cursor)
-    for name, turn, strokes in recorded_turns(path, tolerance):
+    for name, turn, strokes in recorded_turns(recording, tolerance):
         said = turn["text"]
         start = -1 if current is None else current[0].find(said, current[2])
         while start < 0:  # the turn starts the next item: the anchors left of the last one were not said
             unspoken += 0 if current is None else sum(span is not None for span in current[1])
             text, anchors = next(queue, (None, ()))
             if text is None:
-                raise ValueError(f"{path}: a recorded turn matches no item left: {said[:60]!r}")
+                raise ValueError(f"a recorded turn matches no item left: {said[:60]!r}")
             current = (text, annotated_spans(text, tuple(anchors)), 0)
             start = text.find(said)
         text, spans, _ = current
@@ -93,12 +97,13 @@ def read_gold_anchor_sync(path: str | Path, items: Sequence[tuple[str, Sequence[
     return rows, unspoken + sum(len(anchors) for _, anchors in queue)
 
 
-def recorded_turns(path: str | Path,
+def recorded_turns(recording: Recording,
                    tolerance: float = STROKE_TOLERANCE) -> Iterator[tuple[str, dict, list[StrokeSync]]]:
     """Each recorded /speech/timeline turn: its name ("turn-N"), message and gestures' measured strokes."""
-    topics = read_recording(path)
+    topics = recording if isinstance(recording, dict) else read_recording(recording)
     if TIMELINE not in topics:
-        raise ValueError(f"{path}: no {TIMELINE} channel (recorded before stroke-sync recording existed?)")
+        source = "the recording" if isinstance(recording, dict) else recording
+        raise ValueError(f"{source}: no {TIMELINE} channel (recorded before stroke-sync recording existed?)")
     commands = topics.get("/joints/command", [])
     times = np.array([m["t"] for _, m in commands])
     q = np.array([m["q"] for _, m in commands])
