@@ -95,12 +95,14 @@ def wait_ready(port: int, server: subprocess.Popen, timeout_s: float = 300.0) ->
     raise TimeoutError("serve did not answer /api/health")
 
 
-def wait_idle(port: int, timeout_s: float = 60.0) -> None:
-    """Until the sequencer runs and holds nothing (the robot finished the turn)."""
+def wait_idle(port: int, speech_end: float, timeout_s: float = 60.0) -> None:
+    """Until the turn's speech has ended (server clock) and the sequencer runs and holds nothing: the robot
+    finished the turn. The sequencer alone is not enough: between two gestures of a turn it can be empty
+    while the speech goes on, and the next text would then interrupt the turn."""
     end = time.monotonic() + timeout_s
     while time.monotonic() < end:
         status = call(port, "/api/status")
-        if status["active"] is None and not status["pending"]:
+        if status["server_now"] >= speech_end and status["active"] is None and not status["pending"]:
             return
         time.sleep(0.1)
 
@@ -111,9 +113,9 @@ def drive(port: int, texts: list[str]) -> list[dict]:
     sent, by_id = [], {}  # (request time, id of the reply's last message); turn messages by id
     for text in texts:
         requested = time.perf_counter()
-        sent.append((requested, call(port, "/api/say", {"text": text})["id"]))
-        time.sleep(0.2)  # let the first gesture become active before polling for idle
-        wait_idle(port)
+        reply = call(port, "/api/say", {"text": text})  # the reply's last sentence turn
+        sent.append((requested, reply["id"]))
+        wait_idle(port, (reply.get("speech_start") or 0.0) + reply.get("speech", {}).get("duration_s", 0.0))
         # the server keeps a bounded log: collect each turn (with its executed strokes) while it is there
         by_id |= {m["id"]: m for m in call(port, "/api/turns")["log"] if m["type"] == "turn"}
     turns, previous = [], 0

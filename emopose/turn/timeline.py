@@ -16,6 +16,11 @@ backwards from there. Gestures are placed in the order of their words, each agai
    blends to a via pose, halfway to rest ("via_halfway") or rest itself ("via_rest"), and on into this
    preparation, the whole path passing the same safety check;
 6. dropped, with the reason, when none of these fits.
+Every placement, not only a blend, must pass the robot's safety check over its whole motion from the pose
+it starts at, as the sequencer builds it at dispatch (a motion at some intensities brings the arms within
+the clearance, e.g. self_hug at 4 from rest); a refused timing is passed over for the next one, and a
+gesture refused at every timing that fits is dropped with the reason, which the schedule's softening then
+tries at lower intensities (emopose/stages/softening.py) instead of the sequencer refusing it mid-reply.
 The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
 preparation needs more, it is compressed (down to `first_scale`: only the speed bound limits it), then
 goes straight to the stroke start ("direct", after several preparation keyframes), then lands late.
@@ -36,6 +41,7 @@ from emopose.execution.trajectory import TrajectoryBuilder, blend_weight, smooth
 from emopose.turn.model import Fit, GestureTiming, ModulatedGesture
 
 _U = np.linspace(0.0, 1.0, 201)
+CHECK_OVERSAMPLING = 4
 _BLEND_CURVE = blend_weight(_U)
 
 
@@ -86,7 +92,11 @@ class TimelinePlanner:
                  safety: Callable[[np.ndarray], str | None] | None = None) -> None:
         self.builder = builder
         self.settings = settings
-        self.safety = safety  # the sequencer's pre-dispatch check, applied to co-articulation blends
+        self.safety = safety  # the sequencer's pre-dispatch check, applied to every placement
+        # The check samples each path CHECK_OVERSAMPLING times as densely as the stream: the sequencer
+        # samples it at whatever phase its release tick gives, and a clearance it would sample just under
+        # the bound must not pass here on a luckier phase. (builder.limits are already the planning ones.)
+        self._checked = TrajectoryBuilder(builder.limits, builder.dt / CHECK_OVERSAMPLING, builder.increments)
         knots = np.arange(builder.increments + 1) / builder.increments
         self._smooth_curve = np.interp(_U, knots, smoothstep(knots))  # the waypoint easing G samples
 
@@ -121,26 +131,28 @@ class TimelinePlanner:
             earliest = -self.settings.max_preroll_s
             placed = self._prepare(name, anchors, stroke, steps, origins, False, earliest, aim,
                                    (1.0, self.settings.first_scale))
-            return placed or self._late(name, anchors, stroke, steps, origins, earliest, aim)
+            if isinstance(placed, _Placed):
+                return placed
+            late = self._late(name, anchors, stroke, steps, origins, earliest, aim)
+            unsafe = self._unsafe(late, origins)
+            return f"unsafe: the safety check refuses every timing that fits ({unsafe})" if unsafe else late
         placed = self._prepare(name, anchors, stroke, steps, anchors[0], False, prev.times[-1], aim,
                                (1.0, 1.0))
-        if placed is not None:
+        if isinstance(placed, _Placed):
             return placed
-        unsafe = ""
+        unsafe = placed or ""
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
             placed = self._prepare(name, anchors, stroke, steps, prev.anchors[cut], True, prev.times[cut],
                                    aim, (high, low))
-            if placed is None:
-                continue  # cutting earlier in the stroke leaves more time
-            unsafe = self._unsafe(placed, prev.anchors[cut])
-            if not unsafe:
+            if isinstance(placed, _Placed):
                 prev.cut = cut
                 placed.fit = "coarticulated" if cut == prev.stroke[1] else "shortened"
                 return placed
+            unsafe = placed or unsafe  # None: no time at this cut; cutting earlier leaves more
         retraction = self._retract(prev, low)
         placed = self._prepare(name, anchors, stroke, steps, anchors[0], False, retraction[-1], aim,
                                (1.0, low))
-        if placed is not None:
+        if isinstance(placed, _Placed):
             prev.times[prev.stroke[1]:] = retraction
             return placed
         via = self._via(name, anchors, stroke, steps, prev, aim) if unsafe else None
@@ -161,18 +173,19 @@ class TimelinePlanner:
                 placed = self._prepare(name, shape, (stroke[0] + 1, stroke[1] + 1), np.r_[steps[:1], steps],
                                        start_pose, True,
                                        prev.times[cut], aim, (high, low), lead=2)
-                if placed is not None and not self._unsafe(placed, start_pose):
+                if isinstance(placed, _Placed):
                     prev.cut, placed.fit = cut, fit
                     return placed
         return None
 
     def _unsafe(self, placed: _Placed, start_pose: np.ndarray) -> str:
-        """Why the co-articulated preparation would fail the robot's safety check ("" if it passes)."""
+        """Why the robot's safety check would refuse the placed motion, built from start_pose (a stack of
+        origins: the last, where the arm is) as the sequencer builds it ("" if it passes)."""
         if self.safety is None:
             return ""
-        end = placed.stroke[0]
-        times = np.asarray(placed.times[1:end + 1]) - placed.times[0]
-        motion = self.builder.build_timed(placed.anchors[:end + 1], times, start_pose, blend_in=True)
+        times = np.asarray(placed.times[1:]) - placed.times[0]
+        start = np.atleast_2d(start_pose)[-1]
+        motion = self._checked.build_timed(placed.anchors, times, start, placed.blend_in)
         return self.safety(motion.samples) or ""
 
     def _retract(self, prev: _Placed, scale: float) -> list[float]:
@@ -194,10 +207,13 @@ class TimelinePlanner:
         return q, entry.stroke_span, steps
 
     def _prepare(self, name, anchors, stroke, steps, start_pose, blend_in, earliest, aim,
-                 scales, lead: int = 1) -> _Placed | None:
+                 scales, lead: int = 1) -> _Placed | str | None:
         """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
         to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
-        start from the first `lead` anchors; None if even that would need to start before `earliest`."""
+        start from the first `lead` anchors, passing over any the safety check refuses; None if even the
+        last would need to start before `earliest`, the first refusal's reason if every one that fits was
+        refused."""
+        refused = ""
         shapes = [(anchors, stroke, steps, None)]
         if stroke[0] > lead:  # skip the intermediate preparation keyframes (and their segments' time)
             shapes.append((np.vstack([anchors[:lead], anchors[stroke[0]:]]),
@@ -212,9 +228,13 @@ class TimelinePlanner:
                 start = aim + arrival_lead - sum(durations)
                 if start >= earliest - 1e-9:
                     fit: Fit = how or ("nominal" if scale == 1.0 else "scaled")
-                    return self._finish(name, shape, sync, shape_steps, start_pose, start, durations, aim,
-                                        aim, fit, blend_in, float(scale))
-        return None
+                    placed = self._finish(name, shape, sync, shape_steps, start_pose, start, durations, aim,
+                                          aim, fit, blend_in, float(scale))
+                    unsafe = self._unsafe(placed, start_pose)
+                    if not unsafe:
+                        return placed
+                    refused = refused or unsafe
+        return refused or None
 
     def _late(self, name, anchors, stroke, steps, origins, start, aim) -> _Placed:
         """The first gesture when even the pre-roll and the fastest preparation cannot meet its word."""

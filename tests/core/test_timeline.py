@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from emopose.build import safety_check
 from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.library import MotionLibrary
+from emopose.robot.collision import SelfCollisionChecker
 from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 from tests.core.conftest import gesture
 
@@ -109,10 +111,14 @@ def test_every_segment_respects_the_speed_bound_and_the_scale_bounds(g1):
                 assert timing.times[i] - timing.times[i - 1] >= shortest - 1e-9
 
 
+def refuse_blends(rest: np.ndarray):
+    """A safety check that refuses every path not starting at rest (every co-articulation blend)."""
+    return lambda samples: None if np.allclose(samples[0], rest) else "arms collide"
+
+
 def test_an_unsafe_coarticulation_blend_falls_back_to_rest_or_a_drop(g1):
-    refuse_blends = lambda samples: "arms collide"  # noqa: E731 - a safety check that refuses everything
     first, second = gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")
-    (a, b), _ = planner(g1, safety=refuse_blends).plan([first, second], [1.0, 2.2])
+    (a, b), _ = planner(g1, safety=refuse_blends(first.keyframes[0])).plan([first, second], [1.0, 2.2])
     assert not a.cut  # never blended
     assert isinstance(b, str) and "unsafe (arms collide)" in b or not b.blend_in
 
@@ -120,9 +126,10 @@ def test_an_unsafe_coarticulation_blend_falls_back_to_rest_or_a_drop(g1):
 def test_an_unsafe_direct_blend_is_kept_through_a_safe_via_pose(g1):
     first, second = gesture(g1, "point_forward_right"), gesture(g1, "palm_stop")
     rest = first.keyframes[0]
-    # a safety check that passes only paths through the rest pose: the direct blends and the halfway via fail
+    # a safety check that passes only paths through the rest pose in their first half (every motion
+    # retracts to rest at its end): the direct blends and the halfway via fail
     through_rest = lambda samples: (  # noqa: E731
-        None if np.min(np.max(np.abs(samples - rest), axis=1)) < 1e-3 else "arms collide")
+        None if np.min(np.max(np.abs(samples[:len(samples) // 2] - rest), axis=1)) < 1e-3 else "arms collide")
     (a, b), _ = planner(g1, safety=through_rest).plan([first, second], [1.0, 2.6])
     assert b.fit == "via_rest" and b.blend_in and a.cut
     assert np.allclose(b.keyframes[1], rest)  # the via pose, before the preparation
@@ -132,8 +139,28 @@ def test_an_unsafe_direct_blend_is_kept_through_a_safe_via_pose(g1):
     poses = [a.keyframes[-1], *b.keyframes[1:]]
     for i in range(1, len(b.times)):
         assert b.times[i] - b.times[i - 1] >= builder.segment_minimum(poses[i - 1], poses[i], i == 1) - 1e-9
-    (_, dropped), _ = planner(g1, safety=lambda samples: "arms collide").plan([first, second], [1.0, 2.6])
+    (_, dropped), _ = planner(g1, safety=refuse_blends(rest)).plan([first, second], [1.0, 2.6])
     assert "unsafe (arms collide) and no safe via pose fits" in dropped
+
+
+def test_a_motion_the_safety_check_refuses_at_every_timing_is_dropped_with_the_reason(g1):
+    """self_hug at intensity 4 brings a forearm within 5 mm of the other hand from rest, whatever its
+    timing: the timeline drops it with the check's reason instead of handing the sequencer a motion it
+    would refuse at dispatch (the schedule's softening then plays it softer: test_softening)."""
+    check = safety_check(SelfCollisionChecker(clearance=0.01))
+    hug, point = gesture(g1, "self_hug", intensity=4), gesture(g1, "point_forward_right")
+    (dropped, placed), _ = planner(g1, safety=check).plan([hug, point], [1.0, 4.0])
+    assert dropped.startswith("unsafe: the safety check refuses every timing that fits (left_forearm vs")
+    assert check(built(g1, placed, placed.keyframes[0])) is None
+    (at_three,), _ = planner(g1, safety=check).plan([gesture(g1, "self_hug")], [1.0])
+    assert not isinstance(at_three, str) and check(built(g1, at_three, at_three.keyframes[0])) is None
+
+
+def built(library, timing, start: np.ndarray) -> np.ndarray:
+    """The samples the sequencer builds for a placed gesture starting at `start`."""
+    times = np.asarray(timing.times[1:]) - timing.times[0]
+    builder = TrajectoryBuilder(library.limits)
+    return builder.build_timed(timing.keyframes, times, start, timing.blend_in).samples
 
 
 def test_settings_are_validated():

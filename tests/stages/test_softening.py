@@ -7,10 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from emopose.build import safety_check
 from emopose.execution.trajectory import TrajectoryBuilder
+from emopose.robot.collision import SelfCollisionChecker
 from emopose.stages.softening import SofteningSettings, plan_softening, softened
 from tests.core.conftest import gesture
-from tests.core.test_timeline import arrival, planner
+from tests.core.test_timeline import arrival, built, planner
 
 
 def within_speed_bound(library, timing) -> bool:
@@ -79,3 +81,12 @@ def test_a_gesture_with_no_room_after_the_previous_stroke_is_played_softer_not_d
     _, (_, kept), _ = plan_softening(planner(g1), [point, nod], onsets, None,
                                      SofteningSettings(lowest_intensity=4))
     assert kept == dropped  # switched off: the timeline's own reason
+
+
+def test_a_motion_refused_by_the_safety_check_at_its_intensity_is_played_softer(g1):
+    """self_hug at 4 is refused at every timing from rest (test_timeline); softer, it passes and is played."""
+    check = safety_check(SelfCollisionChecker(clearance=0.01))
+    hug = gesture(g1, "self_hug", intensity=4)
+    played, (timing,), _ = plan_softening(planner(g1, safety=check), [hug], [1.0], None, SofteningSettings())
+    assert timing.fit == "softened" and played[0].name == "self_hug" and played[0].intensity < 4
+    assert check(built(g1, timing, timing.keyframes[0])) is None
