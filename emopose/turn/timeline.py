@@ -213,7 +213,7 @@ class TimelinePlanner:
         start from the first `lead` anchors, passing over any the safety check refuses; None if even the
         last would need to start before `earliest`, the first refusal's reason if every one that fits was
         refused."""
-        refused = ""
+        refused, tried = "", set()  # scales the speed bound clamps give the same timing: check it once
         shapes = [(anchors, stroke, steps, None)]
         if stroke[0] > lead:  # skip the intermediate preparation keyframes (and their segments' time)
             shapes.append((np.vstack([anchors[:lead], anchors[stroke[0]:]]),
@@ -230,6 +230,9 @@ class TimelinePlanner:
                     fit: Fit = how or ("nominal" if scale == 1.0 else "scaled")
                     placed = self._finish(name, shape, sync, shape_steps, start_pose, start, durations, aim,
                                           aim, fit, blend_in, float(scale))
+                    if tuple(placed.times) in tried:
+                        continue
+                    tried.add(tuple(placed.times))
                     unsafe = self._unsafe(placed, start_pose)
                     if not unsafe:
                         return placed
