@@ -16,11 +16,9 @@ backwards from there. Gestures are placed in the order of their words, each agai
    blends to a via pose, halfway to rest ("via_halfway") or rest itself ("via_rest"), and on into this
    preparation, the whole path passing the same safety check;
 6. dropped, with the reason, when none of these fits.
-Every placement, not only a blend, must pass the robot's safety check over its whole motion from the pose
-it starts at, as the sequencer builds it at dispatch (a motion at some intensities brings the arms within
-the clearance, e.g. self_hug at 4 from rest); a refused timing is passed over for the next one, and a
-gesture refused at every timing that fits is dropped with the reason, which the schedule's softening then
-tries at lower intensities (emopose/stages/softening.py) instead of the sequencer refusing it mid-reply.
+Every placement passes the robot's safety check over its whole motion (emopose/turn/placement.py); a
+refused timing is passed over for the next, and a gesture refused at every timing that fits is dropped
+with the reason, so the schedule's softening tries it softer (emopose/stages/softening.py).
 The first gesture may start before the speech: audio is delayed by up to `max_preroll_s`; if its
 preparation needs more, it is compressed (down to `first_scale`: only the speed bound limits it), then
 goes straight to the stroke start ("direct", after several preparation keyframes), then lands late.
@@ -32,16 +30,16 @@ planning time (interrupted motion, the thinking gesture), that segment is long e
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from emopose import STROKE_TOLERANCE
 from emopose.execution.trajectory import TrajectoryBuilder, blend_weight, smoothstep
 from emopose.turn.model import Fit, GestureTiming, ModulatedGesture
+from emopose.turn.placement import PathCheck, Placed
 
 _U = np.linspace(0.0, 1.0, 201)
-CHECK_OVERSAMPLING = 4
 _BLEND_CURVE = blend_weight(_U)
 
 
@@ -64,39 +62,12 @@ class TimelineSettings:
             raise ValueError("timeline max_preroll_s must be >= 0 and tolerance > 0")
 
 
-@dataclass
-class _Placed:
-    """A gesture being placed: its anchors (keyframe 0 = start pose) and their times (mutable: a later
-    gesture may cut it)."""
-
-    name: str
-    anchors: np.ndarray
-    stroke: tuple[int, int]
-    steps: np.ndarray  # nominal length (s) of each segment, anchors[i] -> anchors[i + 1]
-    times: list[float]
-    target: float
-    arrival: float
-    fit: Fit
-    blend_in: bool
-    scale: float
-    cut: int = field(default=-1)
-
-    def timing(self) -> GestureTiming:
-        keep = len(self.times) if self.cut < 0 else self.cut + 1
-        return GestureTiming(self.anchors[:keep], tuple(self.times[:keep]), self.stroke, self.target,
-                             self.arrival, self.fit, self.blend_in, self.scale, cut=self.cut >= 0)
-
-
 class TimelinePlanner:
     def __init__(self, builder: TrajectoryBuilder, settings: TimelineSettings,
                  safety: Callable[[np.ndarray], str | None] | None = None) -> None:
         self.builder = builder
         self.settings = settings
-        self.safety = safety  # the sequencer's pre-dispatch check, applied to every placement
-        # The check samples each path CHECK_OVERSAMPLING times as densely as the stream: the sequencer
-        # samples it at whatever phase its release tick gives, and a clearance it would sample just under
-        # the bound must not pass here on a luckier phase. (builder.limits are already the planning ones.)
-        self._checked = TrajectoryBuilder(builder.limits, builder.dt / CHECK_OVERSAMPLING, builder.increments)
+        self.check = PathCheck(builder, safety)  # the sequencer's pre-dispatch check, on every placement
         knots = np.arange(builder.increments + 1) / builder.increments
         self._smooth_curve = np.interp(_U, knots, smoothstep(knots))  # the waypoint easing G samples
 
@@ -105,7 +76,7 @@ class TimelinePlanner:
         """Timing (or a drop reason) per gesture, in the given order, and the speech pre-roll (s).
         `arm`: the arm's pose now, if it may not be at rest when the first gesture starts."""
         out: list[GestureTiming | str] = [""] * len(gestures)
-        placed: list[tuple[int, _Placed]] = []
+        placed: list[tuple[int, Placed]] = []
         for k in sorted(range(len(gestures)), key=lambda k: onsets[k]):
             aim = onsets[k] + self.settings.lead_s - self.settings.lag_s
             gesture = self._place(gestures[k], aim, placed[-1][1] if placed else None, arm)
@@ -119,8 +90,8 @@ class TimelinePlanner:
         return out, preroll
 
     # -- placing one gesture -------------------------------------------------------------------------
-    def _place(self, gesture: ModulatedGesture, aim: float, prev: _Placed | None,
-               arm: np.ndarray | None) -> _Placed | str:
+    def _place(self, gesture: ModulatedGesture, aim: float, prev: Placed | None,
+               arm: np.ndarray | None) -> Placed | str:
         anchors, stroke, steps = self._shape(gesture)
         low, high = self.settings.scale
         name = gesture.name
@@ -131,20 +102,20 @@ class TimelinePlanner:
             earliest = -self.settings.max_preroll_s
             placed = self._prepare(name, anchors, stroke, steps, origins, False, earliest, aim,
                                    (1.0, self.settings.first_scale))
-            if isinstance(placed, _Placed):
+            if isinstance(placed, Placed):
                 return placed
             late = self._late(name, anchors, stroke, steps, origins, earliest, aim)
-            unsafe = self._unsafe(late, origins)
+            unsafe = self.check.refusal(late, origins)
             return f"unsafe: the safety check refuses every timing that fits ({unsafe})" if unsafe else late
         placed = self._prepare(name, anchors, stroke, steps, anchors[0], False, prev.times[-1], aim,
                                (1.0, 1.0))
-        if isinstance(placed, _Placed):
+        if isinstance(placed, Placed):
             return placed
         unsafe = placed or ""
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
             placed = self._prepare(name, anchors, stroke, steps, prev.anchors[cut], True, prev.times[cut],
                                    aim, (high, low))
-            if isinstance(placed, _Placed):
+            if isinstance(placed, Placed):
                 prev.cut = cut
                 placed.fit = "coarticulated" if cut == prev.stroke[1] else "shortened"
                 return placed
@@ -152,7 +123,7 @@ class TimelinePlanner:
         retraction = self._retract(prev, low)
         placed = self._prepare(name, anchors, stroke, steps, anchors[0], False, retraction[-1], aim,
                                (1.0, low))
-        if isinstance(placed, _Placed):
+        if isinstance(placed, Placed):
             prev.times[prev.stroke[1]:] = retraction
             return placed
         via = self._via(name, anchors, stroke, steps, prev, aim) if unsafe else None
@@ -163,7 +134,7 @@ class TimelinePlanner:
             f"too little to prepare at {low:g}x and the joint speed bound")
         return f"no room: its stroke is {room * 1e3:.0f} ms after {prev.name}'s stroke start; {why}"
 
-    def _via(self, name, anchors, stroke, steps, prev: _Placed, aim: float) -> _Placed | None:
+    def _via(self, name, anchors, stroke, steps, prev: Placed, aim: float) -> Placed | None:
         """Rule 5: the first safe path from prev's stroke (latest cut first) through a via pose."""
         low, high = self.settings.scale
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
@@ -173,22 +144,12 @@ class TimelinePlanner:
                 placed = self._prepare(name, shape, (stroke[0] + 1, stroke[1] + 1), np.r_[steps[:1], steps],
                                        start_pose, True,
                                        prev.times[cut], aim, (high, low), lead=2)
-                if isinstance(placed, _Placed):
+                if isinstance(placed, Placed):
                     prev.cut, placed.fit = cut, fit
                     return placed
         return None
 
-    def _unsafe(self, placed: _Placed, start_pose: np.ndarray) -> str:
-        """Why the robot's safety check would refuse the placed motion, built from start_pose (a stack of
-        origins: the last, where the arm is) as the sequencer builds it ("" if it passes)."""
-        if self.safety is None:
-            return ""
-        times = np.asarray(placed.times[1:]) - placed.times[0]
-        start = np.atleast_2d(start_pose)[-1]
-        motion = self._checked.build_timed(placed.anchors, times, start, placed.blend_in)
-        return self.safety(motion.samples) or ""
-
-    def _retract(self, prev: _Placed, scale: float) -> list[float]:
+    def _retract(self, prev: Placed, scale: float) -> list[float]:
         """prev's keyframe times from its stroke end on, with the retraction time-scaled."""
         end = prev.stroke[1]
         durations = self._durations(prev.anchors, prev.anchors[0], end, len(prev.anchors) - 1,
@@ -207,7 +168,7 @@ class TimelinePlanner:
         return q, entry.stroke_span, steps
 
     def _prepare(self, name, anchors, stroke, steps, start_pose, blend_in, earliest, aim,
-                 scales, lead: int = 1) -> _Placed | str | None:
+                 scales, lead: int = 1) -> Placed | str | None:
         """Latest start >= earliest whose stroke arrives at `aim`, trying time scales from scales[0] down
         to scales[1], then (a stroke after several preparation keyframes) going straight to the stroke
         start from the first `lead` anchors, passing over any the safety check refuses; None if even the
@@ -233,13 +194,13 @@ class TimelinePlanner:
                     if tuple(placed.times) in tried:
                         continue
                     tried.add(tuple(placed.times))
-                    unsafe = self._unsafe(placed, start_pose)
+                    unsafe = self.check.refusal(placed, start_pose)
                     if not unsafe:
                         return placed
                     refused = refused or unsafe
         return refused or None
 
-    def _late(self, name, anchors, stroke, steps, origins, start, aim) -> _Placed:
+    def _late(self, name, anchors, stroke, steps, origins, start, aim) -> Placed:
         """The first gesture when even the pre-roll and the fastest preparation cannot meet its word."""
         low = self.settings.first_scale
         durations = self._durations(anchors, origins, 0, stroke[0], steps * low, False)
@@ -249,10 +210,10 @@ class TimelinePlanner:
                             False, low)
 
     def _finish(self, name, anchors, stroke, steps, start_pose, start, prep, aim, arrival, fit, blend_in,
-                scale) -> _Placed:
+                scale) -> Placed:
         rest = self._durations(anchors, start_pose, stroke[0], len(anchors) - 1, steps, False)
         times = np.cumsum([start, *prep, *rest]).tolist()
-        return _Placed(name, anchors, stroke, steps, times, aim, arrival, fit, blend_in, scale)
+        return Placed(name, anchors, stroke, steps, times, aim, arrival, fit, blend_in, scale)
 
     def _durations(self, anchors, start_pose, first, last, lengths, blend_in) -> list[float]:
         """Each segment from keyframe `first` to `last`: lengths[i - 1] into keyframe i, or its minimum."""

@@ -68,7 +68,8 @@ def test_the_live_view_stays_on_screen_and_uncovered(browser, server, size):
         page.screenshot(path=str(SHOTS / f"studio_{size}.png"), full_page=True)
 
 
-def test_a_rejected_gesture_is_shown_rejected_and_named_gestures_are_silent(browser, server):
+def test_a_gesture_the_safety_check_refuses_is_shown_with_the_reason_and_named_gestures_are_silent(browser,
+                                                                                                  server):
     with watched_page(browser, server["base"]) as page:
         page.goto(server["base"] + "/")
         expect(page.locator("#connection")).to_have_text("live", timeout=15_000)
@@ -85,12 +86,14 @@ def test_a_rejected_gesture_is_shown_rejected_and_named_gestures_are_silent(brow
         expect(bubble.locator(".cue .name")).to_have_text("reach_in", timeout=10_000)
         expect(bubble.locator(".reply")).to_have_count(0)  # the motion's name is not spoken
         expect(bubble.locator(".cue.refused")).to_have_count(1, timeout=10_000)
-        expect(bubble.locator(".outcome")).to_contain_text("rejected: right_upper_arm vs torso")
+        # the schedule refuses it (at every timing and intensity) before the sequencer would
+        expect(bubble.locator(".outcome")).to_contain_text("dropped: unsafe: the safety check refuses")
+        expect(bubble.locator(".outcome")).to_contain_text("right_upper_arm vs torso")
         expect(bubble.locator(".cue.fired")).to_have_count(0)
         SHOTS.mkdir(exist_ok=True)
-        page.screenshot(path=str(SHOTS / "chat_rejected_cue.png"))
+        page.screenshot(path=str(SHOTS / "chat_refused_cue.png"))
         page.reload()  # a page opened later sees the outcome in the history
-        expect(page.locator(".bubble.robot").last.locator(".outcome")).to_contain_text("rejected:",
+        expect(page.locator(".bubble.robot").last.locator(".outcome")).to_contain_text("vs torso",
                                                                                        timeout=10_000)
 
 
