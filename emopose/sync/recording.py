@@ -108,13 +108,13 @@ def recorded_turns(recording: Recording,
     times = np.array([m["t"] for _, m in commands])
     q = np.array([m["q"] for _, m in commands])
     sim = topics.get("/joints/sim")
+    sim_times = None if sim is None else np.array([m["t"] for _, m in sim])  # once, not per turn
+    sim_q = None if sim is None else np.array([m["q"] for _, m in sim])
     events = [(m["t"], m["kind"], m["command_id"]) for _, m in topics.get(EVENTS, [])]
     for number, (_, turn) in enumerate(topics[TIMELINE]):
         planned = [PlannedStroke(g["k"], g["motion"], g["command_id"], np.asarray(g["keyframe"]),
                                  g["planned_s"], g["dropped"]) for g in turn["gestures"]]
-        streams = Streams(events, turn["speech_start"], times, q,
-                          None if sim is None else np.array([m["t"] for _, m in sim]),
-                          None if sim is None else np.array([m["q"] for _, m in sim]))
+        streams = Streams(events, turn["speech_start"], times, q, sim_times, sim_q)
         name = f"turn-{number}"
         yield name, turn, measure_strokes(name, planned, [g["onset_s"] for g in turn["gestures"]], streams,
                                           turn["preroll_s"], tolerance)
