@@ -111,7 +111,8 @@ class TimelinePlanner:
                                (1.0, 1.0))
         if isinstance(placed, Placed):
             return placed
-        unsafe = placed or ""
+        itself = placed or ""  # refused even from rest, after prev has retracted: the motion, not a blend
+        unsafe = itself
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
             placed = self._prepare(name, anchors, stroke, steps, prev.anchors[cut], True, prev.times[cut],
                                    aim, (high, low))
@@ -129,6 +130,8 @@ class TimelinePlanner:
         via = self._via(name, anchors, stroke, steps, prev, aim) if unsafe else None
         if via is not None:
             return via
+        if itself:
+            return f"unsafe: the safety check refuses every timing that fits, even from rest ({itself})"
         room = aim - prev.times[prev.stroke[0]]
         why = f"blending from {prev.name} is unsafe ({unsafe}) and no safe via pose fits" if unsafe else (
             f"too little to prepare at {low:g}x and the joint speed bound")

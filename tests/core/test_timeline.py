@@ -152,6 +152,8 @@ def test_a_motion_the_safety_check_refuses_at_every_timing_is_dropped_with_the_r
     (dropped, placed), _ = planner(g1, safety=check).plan([hug, point], [1.0, 4.0])
     assert dropped.startswith("unsafe: the safety check refuses every timing that fits (left_forearm vs")
     assert check(built(g1, placed, placed.keyframes[0])) is None
+    (_, after), _ = planner(g1, safety=check).plan([point, hug], [1.0, 4.0])  # not a blend's fault either
+    assert after.startswith("unsafe: the safety check refuses every timing that fits, even from rest (")
     (at_three,), _ = planner(g1, safety=check).plan([gesture(g1, "self_hug")], [1.0])
     assert not isinstance(at_three, str) and check(built(g1, at_three, at_three.keyframes[0])) is None
 
