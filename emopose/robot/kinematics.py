@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from emopose.robot.g1_spec import ARM_DOF
+from emopose.robot.g1_spec import ARM_DOF, ARM_JOINTS
 
 LEFT, RIGHT = 0, 1
 MIRROR_SIGNS = np.array([1.0, -1.0, -1.0, 1.0, -1.0, 1.0, -1.0])  # q_right = MIRROR_SIGNS * q_left
@@ -170,6 +170,16 @@ def hand_jacobian(q: np.ndarray, side: int, along_x: float = HAND_TIP) -> np.nda
     point = hand_point(rot, pos, along_x)
     axes = np.stack([rot[..., j, :, a] for j, a in enumerate(AXES)], axis=-2)  # world joint axes
     return np.swapaxes(np.cross(axes, point[..., None, :] - pos), -1, -2)
+
+
+def arms_apart(q: np.ndarray, angle: float) -> np.ndarray:
+    """q with both shoulders rolled `angle` rad further outward: the hands part sideways, so a path
+    between two hands-together poses (clasped, on the heart) need not pass them through each other."""
+    out = np.array(q, dtype=float)
+    roll = ARM_JOINTS.index("shoulder_roll")
+    out[..., roll] += angle
+    out[..., ARM_DOF + roll] += MIRROR_SIGNS[roll] * angle
+    return out
 
 
 def mirror(q: np.ndarray) -> np.ndarray:

@@ -21,7 +21,7 @@ from emopose.speech.clip import SpeechClip
 ResolveRule = Literal["exact", "class_default", "neutral", "gated"]
 ReleaseRule = Literal["anchor", "words", "interpolated", "even", "immediate"]
 Fit = Literal["nominal", "scaled", "direct", "coarticulated", "shortened", "softened", "via_halfway",
-              "via_rest", "late"]
+              "via_rest", "via_apart", "late"]
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,9 @@ backwards from there. Gestures are placed in the order of their words, each agai
    blend the robot's safety check would refuse (the arms would collide) is not used;
 4. retracted fast: the previous gesture retracts at up to `scale[0]`, this one prepares from rest;
 5. via a pose, only where 2-3 fit in time but every blend was unsafe: the previous stroke (cut as in 3)
-   blends to a via pose, halfway to rest ("via_halfway") or rest itself ("via_rest"), and on into this
+   blends to a via pose, halfway to rest ("via_halfway"), rest itself ("via_rest") or its own pose with
+   both shoulders rolled outward ("via_apart": between two hands-together poses, such as hands_clasped
+   then hands_on_heart, the other paths pass the hands through each other), and on into this
    preparation, the whole path passing the same safety check;
 6. dropped, with the reason, when none of these fits.
 Every placement passes the robot's safety check over its whole motion (emopose/turn/placement.py); a
@@ -36,10 +38,14 @@ import numpy as np
 
 from emopose import STROKE_TOLERANCE
 from emopose.execution.trajectory import TrajectoryBuilder, blend_weight, smoothstep
+from emopose.robot.kinematics import arms_apart
 from emopose.turn.model import Fit, GestureTiming, ModulatedGesture
 from emopose.turn.placement import PathCheck, Placed
 
 _U = np.linspace(0.0, 1.0, 201)
+# Outward shoulder roll of the "via_apart" pose: parts the fingertips of clasped hands by 8-13 cm each side,
+# which the hands_clasped -> hands_on_heart blend needs (0.2 rad left it refused).
+VIA_APART_ROLL = 0.35
 _BLEND_CURVE = blend_weight(_U)
 
 
@@ -142,7 +148,10 @@ class TimelinePlanner:
         low, high = self.settings.scale
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
             start_pose = prev.anchors[cut]
-            for via, fit in (((start_pose + anchors[0]) / 2, "via_halfway"), (anchors[0], "via_rest")):
+            apart = np.clip(arms_apart(start_pose, VIA_APART_ROLL), self.builder.limits.lower,
+                            self.builder.limits.upper)
+            for via, fit in (((start_pose + anchors[0]) / 2, "via_halfway"), (anchors[0], "via_rest"),
+                             (apart, "via_apart")):
                 shape = np.vstack([anchors[:1], via, anchors[1:]])  # the via segment as long as the first
                 placed = self._prepare(name, shape, (stroke[0] + 1, stroke[1] + 1), np.r_[steps[:1], steps],
                                        start_pose, True,
