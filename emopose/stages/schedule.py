@@ -130,7 +130,7 @@ class ScheduleStage:
         for k, release in enumerate(releases):
             if release.dropped:
                 log.info("timeline: gesture %d (%s) dropped: %s", k, gestures[k].name, release.dropped)
-            elif release.timing.fit in ("softened", "via_halfway", "via_rest", "via_apart"):
+            elif release.timing.fit == "softened" or release.timing.fit.startswith("via_"):
                 log.info("timeline: gesture %d (%s) fitted %s at intensity %d", k, gestures[k].name,
                          release.timing.fit, gestures[k].intensity)
         return speech, Schedule(reply, releases, tuple(gestures), preroll)

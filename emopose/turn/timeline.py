@@ -148,8 +148,7 @@ class TimelinePlanner:
         low, high = self.settings.scale
         for cut in range(prev.stroke[1], prev.stroke[0] - 1, -1):
             start_pose = prev.anchors[cut]
-            apart = np.clip(arms_apart(start_pose, VIA_APART_ROLL), self.builder.limits.lower,
-                            self.builder.limits.upper)
+            apart = self.builder.limits.keep_inside(arms_apart(start_pose, VIA_APART_ROLL))  # a target pose
             for via, fit in (((start_pose + anchors[0]) / 2, "via_halfway"), (anchors[0], "via_rest"),
                              (apart, "via_apart")):
                 shape = np.vstack([anchors[:1], via, anchors[1:]])  # the via segment as long as the first

@@ -169,6 +169,7 @@ def test_two_hands_together_poses_are_joined_through_a_pose_with_the_hands_parte
     assert arrival(g1, b, a.keyframes[-1]) == pytest.approx(2.5 - 0.05, abs=0.021)
     assert check(built(g1, b, a.keyframes[-1])) is None
 
+
 def built(library, timing, start: np.ndarray) -> np.ndarray:
     """The samples the sequencer builds for a placed gesture starting at `start`."""
     times = np.asarray(timing.times[1:]) - timing.times[0]
