@@ -120,6 +120,7 @@ SCHEMAS: dict[str, dict] = {
         releases=array(
             obj(
                 name=STRING,
+                intensity=INTEGER,  # as played: the softening policy may lower the planner's
                 release_s=NUMBER,
                 how=STRING,
                 trigger_found=BOOLEAN,

@@ -121,8 +121,9 @@ class ScheduleStage:
             return speech, Schedule(reply, releases, tuple(turn.modulated))
         arm = None if self.sequencer is None else self.sequencer.last
         onsets = [t for t, _ in times]
+        on_word = [how in ("anchor", "words") for _, how in times]
         gestures, placed, preroll = plan_softening(self._planner, list(turn.modulated), onsets, arm,
-                                                   self.softening)
+                                                   self.softening, on_word)
         releases = tuple(
             Release(timing.times[0], how, ok, timing=timing) if not isinstance(timing, str)
             else Release(t, how, ok, dropped=timing)

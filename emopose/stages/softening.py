@@ -12,7 +12,9 @@ poses inside the limits stays inside them, and an aimed pose keeps its direction
 shorter preparation under the speed bound, and a blend that stays further from the other arm. The first
 intensity that fits replaces the gesture: its timing's fit is "softened" and its record carries the
 intensity played, so the schedule, the recording and the web UI show what was chosen. If none fits, the
-requested gesture is kept (late, or dropped with the timeline's reason).
+requested gesture is kept (late, or dropped with the timeline's reason). Lateness counts only for a stroke
+aimed at a word: a named gesture (released at once) or one spread over a reply without its trigger has no
+word to be late for, so it is softened only when it would be dropped.
 A first gesture that starts away from rest (after the thinking gesture) is planned from the arm's pose by
 the timeline itself (`arm`), so this policy sees its true preparation.
 """
@@ -46,10 +48,12 @@ class SofteningSettings:
         if self.late_tolerance_s < 0:
             raise ValueError(f"softening.late_tolerance_s must be >= 0, got {self.late_tolerance_s}")
 
-    def fits(self, timing: GestureTiming | str) -> bool:
-        """Placed, and its stroke arrives on time (within the tolerance)."""
-        return not isinstance(timing, str) and (
-            timing.fit != "late" or timing.arrival_s <= timing.target_s + self.late_tolerance_s)
+    def fits(self, timing: GestureTiming | str, on_word: bool = True) -> bool:
+        """Placed, and (aimed at a word) its stroke arrives on time (within the tolerance)."""
+        if isinstance(timing, str):
+            return False
+        on_time = timing.fit != "late" or timing.arrival_s <= timing.target_s + self.late_tolerance_s
+        return on_time or not on_word
 
 
 def softened(gesture: ModulatedGesture, intensity: int, gains: tuple[float, ...]) -> ModulatedGesture:
@@ -60,19 +64,21 @@ def softened(gesture: ModulatedGesture, intensity: int, gains: tuple[float, ...]
 
 
 def plan_softening(planner: TimelinePlanner, gestures: list[ModulatedGesture], onsets: list[float],
-                   arm: np.ndarray | None, settings: SofteningSettings
+                   arm: np.ndarray | None, settings: SofteningSettings, on_word: list[bool] | None = None
                    ) -> tuple[list[ModulatedGesture], list[GestureTiming | str], float]:
     """The gestures as played (some perhaps softened), their timings (or drop reasons), the pre-roll.
-    Gestures are fitted in word order, so a softened one is settled before those after it are tried."""
+    Gestures are fitted in word order, so a softened one is settled before those after it are tried.
+    `on_word[k]`: gesture k's onset is its trigger word's (None: every gesture's is)."""
+    on_word = on_word or [True] * len(gestures)
     placed, preroll = planner.plan(gestures, onsets, arm)
     for k in sorted(range(len(gestures)), key=lambda k: onsets[k]):
-        if settings.fits(placed[k]):
+        if settings.fits(placed[k], on_word[k]):
             continue
         for intensity in range(gestures[k].intensity - 1, settings.lowest_intensity - 1, -1):
             trial = list(gestures)
             trial[k] = softened(gestures[k], intensity, settings.gains)
             out, trial_preroll = planner.plan(trial, onsets, arm)
-            if settings.fits(out[k]):
+            if settings.fits(out[k], on_word[k]):
                 out[k] = replace(out[k], fit="softened")
                 gestures, placed, preroll = trial, out, trial_preroll
                 break

@@ -115,7 +115,8 @@ class Schedule:
 
     def as_json(self) -> dict:
         return {"preroll_s": self.preroll_s, "releases": [
-            {"name": g.name, "release_s": r.release_s, "how": r.how, "trigger_found": r.trigger_found,
+            {"name": g.name, "intensity": g.intensity, "release_s": r.release_s, "how": r.how,
+             "trigger_found": r.trigger_found,
              "dropped": r.dropped, "timing": None if r.timing is None else r.timing.as_json()}
             for g, r in zip(self.gestures, self.releases)]}
 

@@ -5,7 +5,8 @@ carries the trigger's character span in the reply (for highlighting) and its rel
 speech start (Eq. schedule), so the page can light the trigger up when the gesture is released,
 following the audio clock when the reply's WAV plays. In timeline mode a cue also carries its planned
 stroke (`stroke_s`, when the arm is planned to arrive at the stroke, on the trigger word) and, once the
-sequencer reports it, the executed one (`stroke_executed_s`); both relative to speech start.
+sequencer reports it, the executed one (`stroke_executed_s`); both relative to speech start. `intensity`
+is the one played, `requested_intensity` the plan's: the schedule softens a gesture that does not fit.
 
 A cue that was not performed carries its `outcome` ({"kind", "reason"}): a gesture dropped by the
 timeline (it did not fit; the schedule says so) or refused by the sequencer, whose event of a kind in
@@ -51,7 +52,10 @@ def cue_rows(data: dict) -> list[dict]:
         rows.append({
             "k": k, "class": record["class"], "requested": record["variant"],
             "resolved": resolved["resolved"], "resolved_class": resolved["resolved_class"],
-            "rule": resolved["rule"], "intensity": record["intensity"], "confidence": record["confidence"],
+            "rule": resolved["rule"], "confidence": record["confidence"],
+            # as played (a gesture that did not fit may be softened) and as the plan asked
+            "intensity": record["intensity"] if release is None else release["intensity"],
+            "requested_intensity": record["intensity"],
             "trigger": trigger, "char_start": start,
             "char_end": None if start is None else start + len(trigger),
             "release_s": None if release is None else release["release_s"],

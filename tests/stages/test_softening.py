@@ -46,6 +46,15 @@ def test_the_policy_can_be_switched_off_and_leaves_fitting_gestures_alone(g1):
     assert timing.fit == "nominal" and played[0] is raise_arm
 
 
+def test_a_late_stroke_with_no_word_to_be_on_is_played_as_asked(g1):
+    """A named gesture (released at once) has no trigger word: coming late to its aim is not a reason to
+    play it weaker than the user asked."""
+    raise_arm = gesture(g1, "raise_arm_yes", intensity=4)
+    played, (timing,), _ = plan_softening(planner(g1, first_scale=0.6), [raise_arm], [0.0], None,
+                                          SofteningSettings(), on_word=[False])
+    assert timing.fit == "late" and played[0] is raise_arm
+
+
 def test_softening_pulls_the_interior_toward_the_start_pose_by_the_gain_ratio(g1):
     wave = gesture(g1, "wave_off", intensity=4)
     softer = softened(wave, 2, SofteningSettings().gains)

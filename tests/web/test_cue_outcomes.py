@@ -22,7 +22,7 @@ def turn_json(events: list[dict]) -> dict:
     record = {"class": "welcoming", "variant": "face_wave", "intensity": 3, "confidence": 1.0,
               "trigger": "hi"}
     resolved = {"resolved": "face_wave", "resolved_class": "welcoming", "rule": "exact"}
-    release = {"release_s": 0.0, "how": "anchor", "dropped": None}
+    release = {"intensity": 3, "release_s": 0.0, "how": "anchor", "dropped": None}
     return {"plan": {"reply": "hi there", "records": [record] * 3}, "resolved": [resolved] * 3,
             "schedule": {"releases": [release, release,
                                       {**release, "dropped": "no room before the next stroke"}]},
@@ -42,6 +42,29 @@ def test_rejected_and_dropped_gestures_are_marked_on_their_cues_with_the_reason(
     assert dropped["command_id"] is None
     events[1] = {**events[1], "kind": "dropped", "detail": "late"}  # any refusal kind, by its event
     assert cue_rows(turn_json(events))[1]["outcome"] == {"kind": "dropped", "reason": "late"}
+
+
+def test_a_cue_gives_the_intensity_played_and_the_one_the_plan_asked_for():
+    data = turn_json([])
+    data["schedule"]["releases"][0] = {**data["schedule"]["releases"][0], "intensity": 1}  # softened
+    softened, kept, _ = cue_rows(data)
+    assert (softened["intensity"], softened["requested_intensity"]) == (1, 3)
+    assert (kept["intensity"], kept["requested_intensity"]) == (3, 3)
+
+
+def test_a_named_gesture_too_strong_to_fit_runs_softened_and_its_cue_says_so(serve_app, library_copy):
+    write_motion(library_copy, "reach_in", "comforting", [REST, REACH_IN, REST])
+    app, _ = serve_app()  # timeline mode: at 4 and 5 every timing is refused, so the schedule softens it
+    with TestClient(app, base_url=LOCAL) as client:
+        cue = client.post("/api/gesture", json={"name": "reach_in", "intensity": 5}).json()["cues"][0]
+        assert cue["requested_intensity"] == 5 and cue["intensity"] in (1, 2, 3), cue
+        assert cue["outcome"] is None
+
+        def logged_cue():
+            return next(m for m in client.get("/api/turns").json()["log"] if m["type"] == "turn")["cues"][0]
+
+        assert wait_for(lambda: logged_cue()["stroke_executed_s"] is not None)  # it ran
+        assert logged_cue()["outcome"] is None
 
 
 def test_a_gesture_rejected_after_its_turn_was_published_is_shown_rejected(serve_app, library_copy):

@@ -22,13 +22,19 @@ function replyNode(reply, cues) {
   return node;
 }
 
+// The intensity played; a softened gesture (it did not fit on its word at the planned one) says so.
+function intensityWords(cue) {
+  const asked = cue.requested_intensity;
+  return asked !== undefined && asked !== cue.intensity ? `i${cue.intensity}, softened from i${asked}` : `i${cue.intensity}`;
+}
+
 function cueNode(cue) {
   const rule = cue.rule === "exact" ? "exact" : cue.rule.replace("_", " ");
   const asked = cue.requested && cue.requested !== cue.resolved ? ` (asked ${cue.requested})` : "";
   return el("div", { class: "cue", "data-k": cue.k, style: `--cue:${CLASS_COLORS[cue.resolved_class] || "#888"}` },
     el("span", { class: "muted", text: cue.class }), "→",
     el("span", { class: "name", text: cue.resolved }),
-    el("span", { class: "muted", text: `${rule}${asked} · i${cue.intensity}` }),
+    el("span", { class: "muted", text: `${rule}${asked} · ${intensityWords(cue)}` }),
     cue.trigger ? el("span", { class: "trigger", text: `“${cue.trigger}”` }) : null,
     el("span", { class: "time", text: cueTime(cue) }));
 }

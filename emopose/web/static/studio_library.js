@@ -22,8 +22,11 @@ export function wireLibraryActions(page) {
   $("perform").onclick = async () => {
     try {
       const turn = await api("/api/studio/perform", { ...page.draft(), class: $("class").value });
-      say("perform-result", true, `performing the draft on screen at intensity ${turn.cues[0].intensity}`
-        + ` (as ${turn.cues[0].resolved}; the library is unchanged)`);
+      const cue = turn.cues[0];
+      if (cue.outcome) { say("perform-result", false, `not performed: ${cue.outcome.reason}`); return; }
+      const softened = cue.requested_intensity !== cue.intensity ? ` (softened from ${cue.requested_intensity}: it did not fit)` : "";
+      say("perform-result", true, `performing the draft on screen at intensity ${cue.intensity}${softened}`
+        + ` (as ${cue.resolved}; the library is unchanged)`);
     } catch (error) { say("perform-result", false, error.message); }
   };
   $("rename").onclick = async () => {
