@@ -28,7 +28,7 @@ from emopose.execution.trajectory import TrajectoryBuilder
 from emopose.joint_limits import JointLimits
 from emopose.speech.clip import SpeechClip, Synthesizer
 from emopose.stages.softening import SofteningSettings, plan_softening
-from emopose.turn.model import Release, ReleaseRule, Schedule, Turn
+from emopose.turn.model import ON_WORD_RULES, Release, ReleaseRule, Schedule, Turn
 from emopose.turn.timeline import TimelinePlanner, TimelineSettings
 
 MODES = ("anchor", "words", "timeline")
@@ -121,7 +121,7 @@ class ScheduleStage:
             return speech, Schedule(reply, releases, tuple(turn.modulated))
         arm = None if self.sequencer is None else self.sequencer.last
         onsets = [t for t, _ in times]
-        on_word = [how in ("anchor", "words") for _, how in times]
+        on_word = [how in ON_WORD_RULES for _, how in times]
         gestures, placed, preroll = plan_softening(self._planner, list(turn.modulated), onsets, arm,
                                                    self.softening, on_word)
         releases = tuple(

@@ -20,6 +20,7 @@ from emopose.speech.clip import SpeechClip
 
 ResolveRule = Literal["exact", "class_default", "neutral", "gated"]
 ReleaseRule = Literal["anchor", "words", "interpolated", "even", "immediate"]
+ON_WORD_RULES = ("anchor", "words")  # the rules that aim at the trigger's own words (the others: no word)
 Fit = Literal["nominal", "scaled", "direct", "coarticulated", "shortened", "softened", "via_halfway",
               "via_rest", "via_apart", "late"]
 

@@ -55,8 +55,7 @@ function userBubble(text, gesture = false) {
 
 function addTurn(turn, live) {
   clearPlanning();
-  const asked = turn.cues[0]?.requested_intensity ?? turn.cues[0]?.intensity ?? 3; // what the user asked for
-  if (turn.kind !== "say") history.append(userBubble(`▶ perform ${turn.cues[0]?.resolved ?? ""} (i${asked})`, true));
+  if (turn.kind !== "say") history.append(userBubble(`▶ perform ${turn.cues[0]?.resolved ?? ""} (i${turn.cues[0]?.requested_intensity ?? 3})`, true));
   else if (!history.lastElementChild?.matches(`.bubble.user[data-utterance]`)) history.append(userBubble(turn.utterance));
   history.querySelectorAll(".bubble.user[data-utterance]").forEach((n) => n.removeAttribute("data-utterance"));
   const bubble = turnBubble(turn);

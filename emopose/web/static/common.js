@@ -128,3 +128,9 @@ export function drawStick(canvas, stick, { background = "#0f1420" } = {}) {
     g.fillText(view === "front" ? "front (robot's left in blue)" : "side (facing right)", half * i + 8, 16);
   });
 }
+
+// A cue's intensity as played; a softened gesture (it did not fit at the one asked) says so.
+export function intensityWords(cue) {
+  const asked = cue.requested_intensity;
+  return asked !== cue.intensity ? `i${cue.intensity}, softened from i${asked}` : `i${cue.intensity}`;
+}

@@ -2,7 +2,7 @@
 // live highlighting that lights a trigger up when its stroke lands (or at its release time in the
 // paper's modes), relative to speech start. A cue the
 // sequencer did not perform (rejected, dropped) is marked with the reason and never lights up.
-import { CLASS_COLORS, clockTime, el } from "./common.js";
+import { CLASS_COLORS, clockTime, el, intensityWords } from "./common.js";
 
 // The server's character offsets count code points (Python strings); JavaScript strings index UTF-16
 // units, in which an emoji counts twice. Slicing the code-point array keeps the marks on their words.
@@ -20,12 +20,6 @@ function replyNode(reply, cues) {
   }
   node.append(text(at));
   return node;
-}
-
-// The intensity played; a softened gesture (it did not fit on its word at the planned one) says so.
-function intensityWords(cue) {
-  const asked = cue.requested_intensity;
-  return asked !== undefined && asked !== cue.intensity ? `i${cue.intensity}, softened from i${asked}` : `i${cue.intensity}`;
 }
 
 function cueNode(cue) {

@@ -1,7 +1,7 @@
 // Pose Studio's library actions: save the draft, perform it on the robot, rename or delete the opened
 // motion. The server applies the library's checks (name pattern, overwrite, the rest pose, a class's
 // last motion, a backup of every replaced or removed file); the page shows its answer.
-import { api } from "./common.js";
+import { api, intensityWords } from "./common.js";
 
 const $ = (id) => document.getElementById(id);
 
@@ -24,8 +24,7 @@ export function wireLibraryActions(page) {
       const turn = await api("/api/studio/perform", { ...page.draft(), class: $("class").value });
       const cue = turn.cues[0];
       if (cue.outcome) { say("perform-result", false, `not performed: ${cue.outcome.reason}`); return; }
-      const softened = cue.requested_intensity !== cue.intensity ? ` (softened from ${cue.requested_intensity}: it did not fit)` : "";
-      say("perform-result", true, `performing the draft on screen at intensity ${cue.intensity}${softened}`
+      say("perform-result", true, `performing the draft on screen at ${intensityWords(cue)}`
         + ` (as ${cue.resolved}; the library is unchanged)`);
     } catch (error) { say("perform-result", false, error.message); }
   };
