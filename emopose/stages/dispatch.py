@@ -3,7 +3,8 @@
 The audio starts when the sequence stage says (after the timeline's pre-roll, if any).
 The sequence stage released the gestures against the planned speech start; when the audio actually
 starts at another time (a device's launch and output latency), the queued gestures are moved by the
-difference, so they keep their place on the words as heard.
+difference, so they keep their place on the words as heard. A turn that performs nothing (no words,
+every gesture dropped) neither plays nor waits: a reply already playing goes on.
 
 When the loop already runs on its own thread (web UI, tour, G1), dispatch waits on it if asked to;
 otherwise it drives the loop on this thread until the sequencer settles (offline rendering with a
@@ -52,6 +53,9 @@ class Dispatch:
     def __call__(self, turn: Turn) -> DispatchReport:
         sequencer = self.loop.sequencer
         first_event, ticks = sequencer.events.total, self.loop.stats.ticks
+        if turn.performs_nothing():  # no words, no gesture: the reply playing, if any, goes on
+            events = tuple(sequencer.events.since(first_event))
+            return DispatchReport(True, events, 0, turn.submitted.speech_start)
         clock, play_at = self.loop.clock, turn.submitted.play_at
         if clock.now() < play_at:  # the timeline's pre-roll: the first gesture prepares before the words
             self.loop.wait_until(lambda: clock.now() >= play_at - 1e-9, play_at - clock.now() + 1.0)

@@ -26,7 +26,7 @@ from emopose.turn.model import ModulatedGesture, Release, Submission, Turn
 @dataclass
 class SequenceStage:
     """Stage: speech + schedule -> submitted. `interrupt=True` replaces whatever is running (a new
-    utterance) instead of queueing behind it."""
+    utterance) instead of queueing behind it, unless the turn performs nothing (Turn.performs_nothing)."""
 
     sequencer: Sequencer = field(repr=False)
     clock: Clock = field(repr=False)
@@ -52,7 +52,7 @@ class SequenceStage:
         commands = sorted((c for c, r in zip(planned, schedule.releases) if not r.dropped),
                           key=lambda c: c.release_at)
         timings = []
-        if self.interrupt:
+        if self.interrupt and not turn.performs_nothing():
             started = time.perf_counter()
             self.sequencer.interrupt(commands, now=self.clock.now())
             timings.append(time.perf_counter() - started)

@@ -198,6 +198,11 @@ class Turn:
         """The fields a stage may read or write (stage_s is the pipeline's own timing)."""
         return tuple(f.name for f in fields(cls) if f.name != "stage_s")
 
+    def performs_nothing(self) -> bool:
+        """No words to say and every gesture dropped (a named gesture the schedule cannot fit): the
+        sequence and dispatch stages then leave what the robot is doing alone instead of stopping it."""
+        return not self.speech.text.strip() and all(r.dropped for r in self.schedule.releases)
+
     def field_json(self, name: str) -> object:
         value = getattr(self, name)
         return None if value is None else _json(value)

@@ -1,9 +1,14 @@
 """The dispatch stage: starts the audio, then runs the loop until the awaited sequencer state."""
 
+from dataclasses import replace
+
 import pytest
 
+from emopose.contract import EventKind, GestureRecord
 from emopose.execution.sequencer import State
+from emopose.speech.clip import SpeechClip
 from emopose.stages.dispatch import Dispatch
+from emopose.stages.sequence import SequenceStage
 from tests.stages.test_sequence import scheduled_turn
 from tests.wiring import wire
 
@@ -67,3 +72,32 @@ def test_gestures_follow_the_audio_when_it_starts_later_than_planned(library, tm
     first, second = turn.submitted.commands
     assert 0 <= started[first.id] - (planned[0] + 0.13) <= 0.02 + 1e-9  # within one tick of the shift
     assert started[second.id] >= planned[1] + 0.13  # never before its word as heard (it may queue)
+
+
+def dropped_gesture_turn(run, reply):
+    """A turn whose schedule dropped its one gesture (as a named gesture that does not fit is)."""
+    turn = scheduled_turn(run, reply, (GestureRecord(cls="rejecting", trigger=reply or None),))
+    turn.speech = SpeechClip(text=reply, duration_s=0.4 * len(reply.split()))
+    releases = tuple(replace(r, dropped="unsafe: test") for r in turn.schedule.releases)
+    turn.schedule = replace(turn.schedule, releases=releases)
+    return turn
+
+
+def test_a_turn_that_performs_nothing_leaves_the_running_one_alone(library, tmp_path):
+    run = wire(library, tmp_path, record=False)
+    running = submitted_turn(run)
+    run.loop.run_until(lambda: run.sequencer.active is not None, 2.0)
+    interrupting = SequenceStage(run.sequencer, run.loop.clock, run.player, interrupt=True)
+    player = CountingPlayer()
+    silent = dropped_gesture_turn(run, "")
+    silent.submitted = interrupting(silent)
+    report = Dispatch(run.loop, player, until="none")(silent)
+    assert silent.submitted.commands == () and player.played == []
+    assert run.sequencer.active.id == running.submitted.commands[0].id
+    assert [e.kind for e in report.events] == []  # the drop was reported by the sequence stage
+    spoken = dropped_gesture_turn(run, "No.")  # words to say: it replaces the running turn
+    spoken.submitted = interrupting(spoken)
+    Dispatch(run.loop, player, until="none")(spoken)
+    assert player.played == ["No."] and run.sequencer.active is None
+    stopped = [e for e in run.sequencer.events.since(0) if e.kind == EventKind.STOPPED]
+    assert [e.command_id for e in stopped] == [running.submitted.commands[0].id]
