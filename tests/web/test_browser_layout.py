@@ -15,13 +15,12 @@ import pytest
 
 from tests.conftest import write_motion
 from tests.web.browser import SHOTS, get_json, served, watched_page
-from tests.web.test_cue_outcomes import REACH_IN, REST
+from tests.web.test_cue_outcomes import REACH_ACROSS, REACH_IN, REST
 
 pytestmark = pytest.mark.slow
 playwright_api = pytest.importorskip("playwright.sync_api")
 expect = playwright_api.expect
 
-REACH_ACROSS = [*REACH_IN[:8], 0.5, *REACH_IN[9:]]  # the right arm into the torso at every intensity
 VIEWPORTS = {"phone": (420, 900), "desktop": (1400, 900)}
 
 

@@ -1,4 +1,5 @@
-"""A gesture the sequencer did not perform shows as such on its cue, with the reason.
+"""A gesture the sequencer did not perform shows as such on its cue, with the reason (and a named one
+the schedule refuses leaves the reply under way alone).
 
 In live mode a turn is published before its gestures start; a later rejection (self-collision at the
 gesture's start) or drop (the timeline could not fit it) lands on the published cue and is announced.
@@ -15,6 +16,7 @@ from tests.web.test_api import wait_for
 
 REST = [0.1, 0.12, 0.0, 1.2, 0.0, 0.0, 0.0, 0.1, -0.12, 0.0, 1.2, 0.0, 0.0, 0.0]
 REACH_IN = [*REST[:7], -0.5, 0.0, *REST[9:]]  # clean at intensities 1-3, into the torso at 4-5
+REACH_ACROSS = [*REACH_IN[:8], 0.5, *REACH_IN[9:]]  # the right arm into the torso at every intensity
 
 
 def turn_json(events: list[dict]) -> dict:
@@ -65,6 +67,24 @@ def test_a_named_gesture_too_strong_to_fit_runs_softened_and_its_cue_says_so(ser
 
         assert wait_for(lambda: logged_cue()["stroke_executed_s"] is not None)  # it ran
         assert logged_cue()["outcome"] is None
+
+
+def test_a_refused_named_gesture_leaves_the_reply_under_way_alone(serve_app, library_copy):
+    write_motion(library_copy, "reach_across", "comforting", [REST, REACH_ACROSS, REST])
+    app, session = serve_app()  # timeline mode: the schedule drops reach_across at every intensity
+    with TestClient(app, base_url=LOCAL) as client:
+        said = client.post("/api/say", json={"text": "Welcome to the lab."}).json()
+        running = said["cues"][0]["command_id"]
+        refused = client.post("/api/gesture", json={"name": "reach_across", "intensity": 3}).json()
+        assert refused["cues"][0]["outcome"]["kind"] == "dropped"
+
+        def said_cue():
+            return next(m for m in client.get("/api/turns").json()["log"]
+                        if m.get("turn_id") == said["turn_id"] and m["type"] == "turn")["cues"][0]
+
+        assert wait_for(lambda: said_cue()["stroke_executed_s"] is not None)  # the reply's gesture ran on
+        kinds = [e.kind for e in session.res.sequencer.events if e.command_id == running]
+        assert "stopped" not in kinds, kinds
 
 
 def test_a_gesture_rejected_after_its_turn_was_published_is_shown_rejected(serve_app, library_copy):
