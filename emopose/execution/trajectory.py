@@ -142,15 +142,17 @@ class TrajectoryBuilder:
 
     def timing_faults(self, keyframes: np.ndarray, times: tuple[float, ...]) -> list[str]:
         """Authored keyframe times the speed bound forbids, keyframes as written: one line per segment naming
-        the keyframe, its time, the fastest joint and the shortest time the bound allows."""
+        the keyframe, its time, the fastest joint and the shortest time the bound allows, rounded up to
+        10 ms (0.302 s shows as 0.31 s: a gap of the time shown is then allowed)."""
         q, out = np.asarray(keyframes, dtype=float), []
         for k in range(1, len(q)):
             gap, needed = times[k] - times[k - 1], self.segment_minimum(q[k - 1], q[k])
             if needed > gap + 1e-9:
                 j = int(np.argmax(np.abs(q[k] - q[k - 1]) * self._inv_velocity))
+                shown = math.ceil(needed * 100 - 1e-9) / 100
                 out.append(f"K{k} at {times[k]:.2f} s comes {gap:.2f} s after K{k - 1}; "
-                           f"{self.limits.names[j]} needs {needed:.2f} s for it at its planning speed "
-                           f"({self.limits.max_velocity[j]:.2f} rad/s)")
+                           f"{self.limits.names[j]} needs {shown:.2f} s for it "
+                           f"at its planning speed ({self.limits.max_velocity[j]:.2f} rad/s)")
         return out
 
     def tick(self, t: float) -> int:

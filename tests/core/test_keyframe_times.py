@@ -82,6 +82,16 @@ def test_studio_refuses_times_the_speed_bound_forbids_naming_time_and_joint(libr
     assert report.refusal_at(3) == report.problems[0]
 
 
+def test_the_time_a_refusal_names_is_rounded_up_so_that_typing_it_is_allowed(library):
+    builder = TrajectoryBuilder(library.limits)
+    needed = builder.segment_minimum(np.asarray(UP), np.asarray(REST))
+    shown = np.ceil(needed * 100 - 1e-9) / 100
+    assert shown - 0.01 < needed < shown  # the bound falls between two hundredths here
+    fault, = builder.timing_faults(np.array([REST, UP, REST]), (0.0, 0.5, 0.5 + shown - 0.01))
+    assert f"needs {shown:.2f} s" in fault
+    assert builder.timing_faults(np.array([REST, UP, REST]), (0.0, 0.5, 0.5 + shown)) == []
+
+
 # -- shipped motions: no times, so exactly today's trajectories --------------------------------------
 def _digest(array: np.ndarray, decimals: int | None = None) -> str:
     values = np.asarray(array, dtype=float) if decimals is None else np.round(array, decimals) + 0.0

@@ -66,11 +66,16 @@ def test_keyframe_times_are_typed_dragged_undone_and_saved(studio, server):
     type_time(studio, "0.7")
     expect(keyframe(studio, 1)).to_contain_text("0.70 s")
     expect(studio.locator("#times-mode")).to_contain_text("set by hand")
-    expect(studio.locator("#traj-meta")).to_contain_text("1.00 s")
+    # K1 -> K2 in 0.3 s is under the 0.302 s the speed bound needs: the check's reply (it replaces the
+    # evenly spaced draft's "1.00 s") refuses the times, names the time that would do, and previews the
+    # motion slowed by 0.8 %, to the next 20 ms tick
+    expect(studio.locator("#check-notes")).to_contain_text(
+        re.compile(r"K2 at 1\.00 s comes 0\.30 s after K1; right_\w+_joint needs 0\.31 s"))
+    expect(studio.locator("#check-speed")).to_contain_text("too fast")
+    expect(studio.locator("#traj-meta")).to_contain_text("1.02 s")
     type_time(studio, "1.5")  # past K2: refused and said so, never clamped
     expect(studio.locator("#time-note")).to_contain_text("not applied")
     expect(studio.locator("#kf-time")).to_have_value("0.7")
-    studio.wait_for_timeout(400)  # the check of the typed time has come back: the plot shows K1 at 0.7 s
     drag_line(studio, 0.7, 0.4, span=1.0)
     dragged = float(studio.locator("#kf-time").input_value())
     assert 0.35 <= dragged <= 0.45, dragged
