@@ -167,6 +167,32 @@ def test_a_motion_scores_as_its_best_fitting_text_its_examples_included(chooser)
     assert chosen == ("doubting", "shrug")
 
 
+def test_an_example_the_class_head_misreads_gives_its_motion_back_what_the_head_underrates():
+    # finger_wag's example "tsk tsk" lies between chin_stroke's and finger_wag's descriptions
+    axes = np.eye(4, dtype=np.float32)
+    vectors = {text: axes[AXIS[name]] for name, (_, text) in CATALOGUE.items()}
+    vectors["tsk tsk"] = (axes[AXIS["chin_stroke"]] + axes[AXIS["finger_wag"]]) / 2 ** 0.5
+
+    def described(texts):
+        rows = np.stack([vectors[t] for t in texts])
+        return Features(rows, rows, rows, [NO_WORDS] * len(texts))
+
+    def chosen(head_reads_rejecting: float, act: Features) -> tuple:
+        reads = np.full((1, len(CLASSES)), np.log(1 - head_reads_rejecting))
+        reads[0, CLASSES.index("rejecting")] = np.log(head_reads_rejecting)
+        chooser = VariantChooser(new_projections(4), described, Weights(1.0, 1.0, pretrained_share=0.0),
+                                 frozenset(CATALOGUE), lambda texts: np.repeat(reads, len(texts), axis=0))
+        evidence = EVIDENCE | {"finger_wag": ("rejecting", ("naughty", "tsk tsk"))}
+        return chooser.choose(lambda: evidence, 1, "doubting", proba(doubting=0.999), act, MOVE)
+
+    like_the_example = act_near("chin_stroke", "finger_wag", 0.5)
+    assert chosen(0.99, like_the_example) == ("doubting", "chin_stroke")  # the head is right on the example
+    # the head also reads finger_wag's own example as not rejecting: its doubt counts for that much less
+    assert chosen(np.exp(-6.0), like_the_example) == ("rejecting", "finger_wag")
+    # an act the example fits worse than the act's own class's motion gets no credit, however large
+    assert chosen(np.exp(-50.0), act_near("chin_stroke", "finger_wag", 0.1)) == ("doubting", "chin_stroke")
+
+
 def test_descriptions_are_read_again_when_the_library_changes(chooser):
     calls = []
 

@@ -124,6 +124,12 @@ class LocalInference:
     def boundary_logits(self, analysis: Analysis, pieces: list[Segment]) -> np.ndarray:
         return boundary_scores(self.model.boundary_head, analysis, pieces)
 
+    def read_classes(self, texts: list[str]) -> np.ndarray:
+        """(N, classes): the class head's log-probabilities of each whole text read as one act."""
+        logits = np.stack([self.classify_spans(a, [(0, len(text))])[0][0]
+                           for a, text in zip(self.analyse(texts), texts, strict=True)])
+        return logits - np.logaddexp.reduce(logits, axis=1, keepdims=True)
+
     def describe(self, texts: list[str]) -> Features:
         """The variant features of whole texts (descriptions)."""
         rows = [variant_features(a, [(0, len(a.starts))]) for a in self.analyse(texts)] if texts else []

@@ -133,7 +133,7 @@ class LocalPlanner:
                                     settings.trace_inference)
         model = self.model.model
         self.variants = VariantChooser(model.variant_projections, self.model.describe, self.variant_weights,
-                                       frozenset(model.annotated_motions))
+                                       frozenset(model.annotated_motions), self.model.read_classes)
 
     def retrain(self) -> None:
         """Train again (replacing the cached artifact) and use the new model (train_local's job.retrain)."""

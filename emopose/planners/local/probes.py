@@ -51,7 +51,8 @@ def with_candidate(planner: LocalPlanner, entry: LibraryEntry) -> LocalPlanner:
     trial = copy.copy(planner)
     trial._evidence = lambda: {**motion_evidence(planner.library), entry.name: (entry.cls, evidence)}
     trial.variants = VariantChooser(planner.variants.projections, planner.variants.describe,
-                                    planner.variants.weights, planner.variants.annotated)
+                                    planner.variants.weights, planner.variants.annotated,
+                                    planner.variants.read_classes)
     return trial
 
 

@@ -30,10 +30,14 @@ frozen states, so they are trained apart from the encoder, in seconds, after its
 
 A motion file's `examples:` (utterances it fits) are read like its description, and a motion scores as
 its best-fitting text: evidence for a new motion's uses without retraining (planners/local/catalogue.py).
+An example is also a labelled utterance: how unlikely the class head finds the motion's class on it is
+how far the head underrates that motion's uses, so an act the example fits best gets that much back.
 
 The class is chosen with the motion (VariantChooser.choose): a motion of another class that fits the act
 better than its own class's best can move it, by log p(class) + w * (the score margin); w is larger for a
-motion the training data never annotated, whose uses the class head cannot know.
+motion the training data never annotated, whose uses the class head cannot know. A motion whose
+best-fitting text is one of its examples adds -log p(its class | that example) to log p(class) where it
+fits the act better than the act's own class's motions.
 """
 
 from __future__ import annotations
@@ -159,20 +163,38 @@ class ClassMove:
 
 class VariantChooser:
     """Inference: an act's class and motion. The descriptions are read and projected once per library
-    version. describe(texts) -> their Features; annotated: the motions the training data annotates."""
+    version. describe(texts) -> their Features; annotated: the motions the training data annotates;
+    read_classes(texts) -> (N, classes) the class head's log-probabilities of whole texts (None: a motion's
+    examples count by their fit alone)."""
 
     def __init__(self, projections, describe: Callable[[list[str]], Features], weights: Weights,
-                 annotated: frozenset[str]) -> None:
+                 annotated: frozenset[str],
+                 read_classes: Callable[[list[str]], np.ndarray] | None = None) -> None:
         self.projections, self.describe, self.weights = projections, describe, weights
-        self.annotated = annotated
+        self.annotated, self.read_classes = annotated, read_classes
         self._cached: tuple = (-1, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool), ())
+
+    def _underrated(self, entries: dict[str, tuple[str, tuple[str, ...]]]) -> np.ndarray:
+        """Per text of the catalogue: -log p(its motion's class) as the class head reads it for an example
+        utterance, 0 for a description (or without read_classes)."""
+        evidence = [(CLASSES.index(cls), k > 0) for cls, texts in entries.values() for k in range(len(texts))]
+        examples = [text for _, texts in entries.values() for text in texts[1:]]
+        underrated = np.zeros(len(evidence))
+        if self.read_classes is None or not examples:
+            return underrated
+        is_example = np.array([example for _, example in evidence])
+        own_class = np.array([c for c, example in evidence if example])
+        underrated[is_example] = -self.read_classes(examples)[np.arange(len(examples)), own_class]
+        return underrated
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, tuple[str, ...]]]], version: int, cls: str,
                proba: np.ndarray, act: Features, move: ClassMove, excluded: frozenset[str] = frozenset(),
                barred: frozenset[str] = frozenset()) -> tuple[str, str | None]:
         """(class, motion) for an act the split model reads as cls with class probabilities proba.
         Within cls the best-scoring motion is chosen. Another class c moves the act when its best motion
-        m fits by enough more: log proba[c] + w(m) * (score(m) - score of cls's best) > log proba[cls].
+        m fits by enough more: log proba[c] + w(m) * (score(m) - score of cls's best) > log proba[cls],
+        each side with its motion's credit when that motion's best-fitting text is an example (m's only
+        when m fits better).
         w(m) is move.annotated for a motion the training data annotates and move.new for one it never
         saw: the class head's probabilities already weigh what the data says of a known motion's uses,
         while for a new one (a "finger wag" added by file, for a scolding the model read as comforting)
@@ -195,25 +217,30 @@ class VariantChooser:
             classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
             is_annotated = np.array([name in self.annotated for name in entries], dtype=bool)
             owner = np.repeat(np.arange(len(entries)), [len(evidence) for _, evidence in entries.values()])
-            cached = self._cached = (version, list(entries), classes, is_annotated, (motions, owner))
-        _, names, classes, is_annotated, (motions, owner) = cached
+            cached = self._cached = (version, list(entries), classes, is_annotated,
+                                     (motions, owner, self._underrated(entries)))
+        _, names, classes, is_annotated, (motions, owner, underrated) = cached
         own = CLASSES.index(cls)
         selectable = np.array([name not in barred for name in names], dtype=bool)
         members = np.flatnonzero((classes == own) & selectable)
         if not len(members):
             return cls, None
-        row = np.full(len(names), -np.inf)
+        row, credit = np.full(len(names), -np.inf), np.zeros(len(names))
         with torch.inference_mode():  # a motion's score: its best-fitting text (description or example)
-            np.maximum.at(row, owner, scores(projected(self.projections, act), motions, self.weights)[0])
+            fits = scores(projected(self.projections, act), motions, self.weights)[0]
+        np.maximum.at(row, owner, fits)
+        best_text = fits >= row[owner]
+        np.maximum.at(credit, owner[best_text], underrated[best_text])  # what its best example gets back
         own_best = members[int(np.argmax(row[members]))]
-        chosen, best_total = own_best, np.log(proba[own] + 1e-12)
+        chosen, best_total = own_best, np.log(proba[own] + 1e-12) + credit[own_best]
         weight = np.where(is_annotated, move.annotated, move.new)
         for other in sorted(set(classes[selectable].tolist()) - {own} - {CLASSES.index(c) for c in excluded}):
             members = np.flatnonzero((classes == other) & selectable)
             m = members[int(np.argmax(row[members]))]
             if not weight[m]:
                 continue  # no weight, no move (the split may have chosen a less likely class for a reason)
-            total = np.log(proba[other] + 1e-12) + weight[m] * (row[m] - row[own_best])
+            margin = row[m] - row[own_best]  # a credit counts only where the example fits better
+            total = np.log(proba[other] + 1e-12) + credit[m] * (margin > 0) + weight[m] * margin
             if total > best_total:  # a tie keeps the split model's class
                 chosen, best_total = m, total
         return CLASSES[classes[chosen]], names[chosen]
