@@ -29,6 +29,7 @@ class TrainingConfig(BaseModel):
     context_distractors: int = Field(ge=0)  # training items given an unrelated dialogue history
     epochs: int = Field(ge=1)
     trainable_layers: int = Field(ge=1, le=6)  # top encoder layers fine-tuned; the rest run once, cached
+    dropout: float = Field(ge=0, lt=1)  # in the fine-tuned layers (the pretrained encoder's: 0.1)
     lr: float = Field(ge=0)
     head_lr: float = Field(ge=0)
     lr_schedule: Literal["constant", "linear"]  # linear: warm up over 5 % of steps, then decay to 0
