@@ -1,4 +1,5 @@
-"""The local planner's variant choice (planners/local/variants.py), on hand-made vectors: no model."""
+"""The local planner's variant choice (planners/local/variants.py, variant_score.py), on hand-made vectors:
+no model."""
 
 from __future__ import annotations
 
@@ -8,8 +9,9 @@ import numpy as np
 import pytest
 
 from emopose import CLASSES
+from emopose.planners.local.variant_score import Features, Weights, new_projections
 from emopose.planners.local.variant_training import AnnotatedAct, fit_variants
-from emopose.planners.local.variants import ClassMove, Features, VariantChooser, Weights, new_projections
+from emopose.planners.local.variants import ClassMove, VariantChooser
 
 CATALOGUE = {"chin_stroke": ("doubting", "hmm"), "shrug": ("doubting", "who knows"),
              "palm_stop": ("rejecting", "stop"), "finger_wag": ("rejecting", "naughty")}

@@ -14,7 +14,7 @@
   utterance is dropped: planners/local.py).
 
 variant_features pools the same token ranges of the semantic and lexical states, and lists their
-tokens, for the variant choice (planners/local_variants.py).
+tokens, for the variant choice (planners/local/variant_score.py).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 
 from emopose import CLASSES
 from emopose.planners.local.segment import Segment
-from emopose.planners.local.variants import Features
+from emopose.planners.local.variant_score import Features
 
 MAX_TOKENS = 128  # the encoder's input, dialogue prefix included
 
@@ -104,7 +104,7 @@ def span_scores(act_head, logit_scale: float, analysis: Analysis,
 
 
 def variant_features(analysis: Analysis, ranges: list[tuple[int, int]]) -> Features:
-    """What the variant choice reads of each token range (planners/local_variants.py): the pooled
+    """What the variant choice reads of each token range (planners/local/variant_score.py): the pooled
     semantic, lexical and distinctive (rarity-weighted word) vectors, and the tokens with their rarity."""
     import torch
 

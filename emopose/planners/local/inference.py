@@ -19,7 +19,7 @@ import numpy as np
 from emopose.planners.local.heads import Analysis, boundary_scores, span_scores, variant_features
 from emopose.planners.local.model import ActModel
 from emopose.planners.local.segment import Segment
-from emopose.planners.local.variants import Features
+from emopose.planners.local.variant_score import Features
 
 log = logging.getLogger(__name__)
 _NAMES = ("input_ids", "token_type_ids", "attention_mask")

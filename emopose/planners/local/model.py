@@ -11,7 +11,7 @@ kept; their character starts are relative to the utterance. One forward pass giv
 - semantic states: the pretrained sentence encoder's own output (a frozen copy of the top layers run
   over the same lower states; mean-pooled, this is all-MiniLM-L6-v2's sentence embedding);
 - lexical states: the word embeddings (weighted by rarity for the distinctive vectors). The variant
-  choice (planners/local_variants.py) compares these with the live library's descriptions, two of them
+  choice (planners/local/variants.py) compares these with the live library's descriptions, two of them
   through small trained projections, so a new or edited motion is scored like a known one.
 
 Inference (bf16, traced) is planners/local_inference.py, training planners/local_training.py, the
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 from emopose.planners.local.config import TrainingConfig
 from emopose.planners.local.heads import MAX_TOKENS, new_heads
-from emopose.planners.local.variants import SMOOTHING, new_projections
+from emopose.planners.local.variant_score import SMOOTHING, new_projections
 
 CONTEXT_TURNS = 2  # dialogue turns read before the utterance (the question and the answer it replies to)
 CONTEXT_CHARS = 180  # at most this many characters of them, the newest (history costs most training tokens)

@@ -50,7 +50,8 @@ from emopose.planners.local.heads import Analysis
 from emopose.planners.local.inference import LocalInference
 from emopose.planners.local.segment import Segment, segments
 from emopose.planners.local.threads import resolve_threads, torch_threads
-from emopose.planners.local.variants import ClassMove, Features, VariantChooser, Weights
+from emopose.planners.local.variant_score import Features, Weights
+from emopose.planners.local.variants import ClassMove, VariantChooser
 
 _UP = re.compile(r"\b(very|really|so|extremely|absolutely|totally|incredibly|truly|definitely|never|"
                  r"always|huge|amazing|terrible|must)\b", re.IGNORECASE)

@@ -1,4 +1,4 @@
-"""Training the variant projections (planners/local/variants.py) on the annotated acts.
+"""Training the variant projections (planners/local/variant_score.py) on the annotated acts.
 
 Each projection learns on its own similarity: cross-entropy of an act's annotated motion against the
 other motions of its class, with a random share of each class's motions left out of every batch
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from emopose import CLASSES
 from emopose.planners.local.config import TrainingConfig
-from emopose.planners.local.variants import unit
+from emopose.planners.local.variant_score import unit
 
 
 def similarity(projection, acts, motions):
