@@ -117,6 +117,7 @@ def test_train_local_search_is_checked_before_anything_is_built():
     ("planner.training.epochs=0", "epochs\n  Input should be greater than or equal to 1"),
     ("planner.training.lr=-0.1", "lr\n  Input should be greater than or equal to 0"),
     ("planner.training.trainable_layers=7", "trainable_layers\n  Input should be less than or equal to 6"),
+    ("planner.training.dropout=1", "dropout\n  Input should be less than 1"),
     ("+planner.training.epochz=3", "epochz\n  Extra inputs are not permitted"),
     ("~planner.training.epochs", "epochs\n  Field required"),  # the YAML is the one place of every value
     ("~planner.history_threshold", "history_threshold\n  Field required"),

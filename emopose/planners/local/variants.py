@@ -17,11 +17,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from emopose import CLASSES
-from emopose.planners.local.variant_score import Features, Weights, projected, scores, word_presence
+from emopose.planners.local.variant_score import Compared, Features, Weights, projected, scores, word_presence
 
 
 @dataclass(frozen=True)
@@ -31,6 +32,18 @@ class ClassMove:
 
     annotated: float  # toward a motion the training data annotates: the class head has read acts about it
     new: float  # toward one it never saw: the motion's description is the only evidence for its uses
+
+
+class _Library(NamedTuple):
+    """The live library as the choice reads it, for one library version."""
+
+    version: int
+    names: list[str]  # the selectable motions
+    classes: np.ndarray  # (M,) each motion's class index
+    is_annotated: np.ndarray  # (M,) whether the training data annotates it
+    texts: Compared | None  # every motion's texts (its description, then its examples)
+    owner: np.ndarray  # (T,) the motion each text belongs to
+    underrated: np.ndarray  # (T,) -log p(owner's class | text) for an example, 0 for a description
 
 
 class VariantChooser:
@@ -44,52 +57,49 @@ class VariantChooser:
                  read_classes: Callable[[list[str]], np.ndarray] | None = None) -> None:
         self.projections, self.describe, self.weights = projections, describe, weights
         self.annotated, self.read_classes = annotated, read_classes
-        self._cached: tuple = (-1, [], np.zeros(0, dtype=int), np.zeros(0, dtype=bool), ())
+        none = np.zeros(0, dtype=int)
+        self._cached = _Library(-1, [], none, none.astype(bool), None, none, none.astype(float))
 
     def _underrated(self, entries: dict[str, tuple[str, tuple[str, ...]]]) -> np.ndarray:
         """Per text of the catalogue: -log p(its motion's class) as the class head reads it for an example
         utterance, 0 for a description (or without read_classes)."""
-        evidence = [(CLASSES.index(cls), k > 0) for cls, texts in entries.values() for k in range(len(texts))]
-        examples = [text for _, texts in entries.values() for text in texts[1:]]
-        underrated = np.zeros(len(evidence))
-        if self.read_classes is None or not examples:
-            return underrated
-        is_example = np.array([example for _, example in evidence])
-        own_class = np.array([c for c, example in evidence if example])
-        underrated[is_example] = -self.read_classes(examples)[np.arange(len(examples)), own_class]
+        is_example = np.array([k > 0 for _, texts in entries.values() for k in range(len(texts))], dtype=bool)
+        examples = [(CLASSES.index(cls), text) for cls, texts in entries.values() for text in texts[1:]]
+        underrated = np.zeros(len(is_example))
+        if self.read_classes is not None and examples:
+            classes, texts = zip(*examples, strict=True)
+            underrated[is_example] = -self.read_classes(list(texts))[np.arange(len(texts)), list(classes)]
         return underrated
 
-    def _library(self, catalogue, version: int) -> tuple:
-        """The live library as choose() reads it, again when its version changes: (version, names,
-        classes, annotated?, (its texts' Compared, the motion owning each text, each text's underrating))."""
+    def _library(self, catalogue, version: int) -> _Library:
+        """The live library, read again when its version changes."""
         import torch
 
         cached = self._cached  # one read: another thread may replace it
-        if cached[0] != version:
+        if cached.version != version:
             entries = catalogue()
             texts = [text for _, evidence in entries.values() for text in evidence]
             with torch.inference_mode():
                 described = projected(self.projections, self.describe(texts))
-                motions = described._replace(words=word_presence(described.words))
-            classes = np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int)
-            is_annotated = np.array([name in self.annotated for name in entries], dtype=bool)
-            owner = np.repeat(np.arange(len(entries)), [len(evidence) for _, evidence in entries.values()])
-            cached = self._cached = (version, list(entries), classes, is_annotated,
-                                     (motions, owner, self._underrated(entries)))
+            cached = self._cached = _Library(
+                version, list(entries), np.array([CLASSES.index(c) for c, _ in entries.values()], dtype=int),
+                np.array([name in self.annotated for name in entries], dtype=bool),
+                described._replace(words=word_presence(described.words)),
+                np.repeat(np.arange(len(entries)), [len(evidence) for _, evidence in entries.values()]),
+                self._underrated(entries))
         return cached
 
-    def _fits(self, act: Features, texts: tuple, motions: int) -> tuple[np.ndarray, np.ndarray]:
+    def _fits(self, act: Features, library: _Library) -> tuple[np.ndarray, np.ndarray]:
         """Per motion: its score (its best-fitting text's: description or example) and its credit (what
         the class head underrates that text by, when it is an example)."""
         import torch
 
-        compared, owner, underrated = texts
-        row, credit = np.full(motions, -np.inf), np.zeros(motions)
+        row, credit = np.full(len(library.names), -np.inf), np.zeros(len(library.names))
         with torch.inference_mode():
-            fits = scores(projected(self.projections, act), compared, self.weights)[0]
-        np.maximum.at(row, owner, fits)
-        best_text = fits >= row[owner]
-        np.maximum.at(credit, owner[best_text], underrated[best_text])
+            fits = scores(projected(self.projections, act), library.texts, self.weights)[0]
+        np.maximum.at(row, library.owner, fits)
+        best_text = fits >= row[library.owner]
+        np.maximum.at(credit, library.owner[best_text], library.underrated[best_text])
         return row, credit
 
     def choose(self, catalogue: Callable[[], dict[str, tuple[str, tuple[str, ...]]]], version: int, cls: str,
@@ -110,16 +120,17 @@ class VariantChooser:
         library's selectable motions, name -> (class, (description text, *example utterances)), read
         again when the library's version changes; a motion scores as its best-fitting text. act: the
         act's Features (one row)."""
-        _, names, classes, is_annotated, texts = self._library(catalogue, version)
+        library = self._library(catalogue, version)
+        names, classes = library.names, library.classes
         own = CLASSES.index(cls)
         selectable = np.array([name not in barred for name in names], dtype=bool)
         members = np.flatnonzero((classes == own) & selectable)
         if not len(members):
             return cls, None
-        row, credit = self._fits(act, texts, len(names))
+        row, credit = self._fits(act, library)
         own_best = members[int(np.argmax(row[members]))]
         chosen, best_total = own_best, np.log(proba[own] + 1e-12) + credit[own_best]
-        weight = np.where(is_annotated, move.annotated, move.new)
+        weight = np.where(library.is_annotated, move.annotated, move.new)
         for other in sorted(set(classes[selectable].tolist()) - {own} - {CLASSES.index(c) for c in excluded}):
             members = np.flatnonzero((classes == other) & selectable)
             m = members[int(np.argmax(row[members]))]
