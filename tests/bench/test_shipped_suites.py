@@ -1,5 +1,6 @@
 """The shipped suite files: counts, balance, fields, anchor order and variants."""
 
+import json
 from collections import Counter
 from itertools import pairwise
 from pathlib import Path
@@ -64,3 +65,22 @@ def test_sequence_variants_exist_in_the_g1_library(compose):
 
     library = make(compose().library, "library")  # the authored G1 set; failing to load it is a failure
     load_sequence(need(SEQUENCE), variant_classes={n: e.cls for n, e in library.snapshot.entries.items()})
+
+
+def test_anchor_agreement_annotations_fit_their_items():
+    """benchmarks/anchor_agreement.py's re-annotations: one anchor of 1-6 words per act, in the text, in
+    order, for the same 160 sequence-suite items in each file."""
+    items = {i.id: i for i in load_sequence(need(SEQUENCE))}
+    folder = PROJECT_ROOT / "benchmarks/data/anchor_agreement"
+    annotated = {}
+    for name in ("written_1", "written_2", "plain"):
+        rows = [json.loads(line) for line in need(folder / f"{name}.jsonl").open()]
+        annotated[name] = [row["id"] for row in rows]
+        for row in rows:
+            item = items[row["id"]]
+            assert len(row["anchors"]) == len(item.labels), row["id"]
+            starts = [item.text.lower().find(a.lower()) for a in row["anchors"]]
+            assert min(starts) >= 0 and starts == sorted(starts), (name, row["id"], row["anchors"])
+            assert all(1 <= len(a.split()) <= 6 for a in row["anchors"]), (name, row["id"])
+    assert len(set(annotated["written_1"])) == 160
+    assert annotated["written_1"] == annotated["written_2"] == annotated["plain"]
