@@ -23,9 +23,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout without installing
 
 from emopose.bench.suites import load_sequence  # noqa: E402
-from emopose.contract import trigger_position  # noqa: E402
 from emopose.speech.espeak import EspeakSynthesizer  # noqa: E402
-from emopose.sync.affiliate import WINDOW_S, anchor_offsets, offset_summary  # noqa: E402
+from emopose.sync.affiliate import WINDOW_S, anchor_offsets, offset_summary, trigger_spans  # noqa: E402
 
 DATA = ROOT / "benchmarks/data/anchor_agreement"
 SUITE = ROOT / "experiments/sequence/sequence_suite.jsonl"
@@ -36,15 +35,19 @@ def read_annotation(name: str) -> dict[str, list[str]]:
     return {row["id"]: row["anchors"] for row in map(json.loads, (DATA / f"{name}.jsonl").open())}
 
 
-def planner_triggers(results: Path) -> dict[str, list[str]]:
-    """The first pass's triggers of a sequence_suite run."""
-    predictions = json.loads(results.read_text())["predictions"]
-    return {p["id"]: p["triggers"] for p in predictions if p["pass"] == 0}
-
-
-def spans(text: str, anchors: list[str]) -> list[tuple[int, int]]:
-    """Each anchor where the schedule would find it (first occurrence, case-insensitive)."""
-    return [(trigger_position(text, a), trigger_position(text, a) + len(a)) for a in anchors]
+def planner_triggers(results: Path, ids: set[str]) -> dict[str, list[str]]:
+    """The first pass's triggers of a sequence_suite run over the shipped suite; SystemExit otherwise."""
+    try:
+        run = json.loads(results.read_text())
+    except (OSError, json.JSONDecodeError) as err:
+        raise SystemExit(f"{results}: not a readable results.json ({err})") from None
+    if run.get("kind") != "sequence_suite":
+        raise SystemExit(f"{results}: kind {run.get('kind')!r}, not a +experiment=sequence_suite run")
+    triggers = {p["id"]: p["triggers"] for p in run["predictions"] if p["pass"] == 0}
+    if missing := sorted(ids - set(triggers)):
+        raise SystemExit(f"{results}: no plan for {len(missing)} of the annotated items (e.g. {missing[0]}); "
+                         f"run sequence_suite on {SUITE.relative_to(ROOT)}")
+    return triggers
 
 
 def main() -> None:
@@ -52,15 +55,20 @@ def main() -> None:
     marked = {name: read_annotation(name) for name in ANNOTATORS}
     items = [item for item in load_sequence(SUITE) if item.id in marked["written_1"]]
     marked["gold"] = {item.id: [item.text[a:b] for a, b in item.spans] for item in items}
-    marked["planner"] = planner_triggers(Path(sys.argv[1]) if len(sys.argv) > 1 else default)
+    marked["planner"] = planner_triggers(Path(sys.argv[1]) if len(sys.argv) > 1 else default,
+                                         set(marked["gold"]))
     synthesizer = EspeakSynthesizer()
     events = {item.id: synthesizer.word_events(item.text) for item in items}
 
     def offsets(reference: str, other: str) -> dict[tuple[str, int], float | None]:
         """(item, act) -> onset of `other`'s words minus the `reference` anchor's, as the job scores it."""
-        return {(item.id, k): o for item in items
-                for k, o in enumerate(anchor_offsets(item.text, spans(item.text, marked[reference][item.id]),
-                                                     marked[other][item.id], events[item.id]))}
+        found = {}
+        for item in items:
+            anchors = trigger_spans(item.text, marked[reference][item.id])
+            words = marked[other][item.id]
+            for k, o in enumerate(anchor_offsets(item.text, anchors, words, events[item.id])):
+                found[item.id, k] = o
+        return found
 
     def agreement(reference: str, other: str, acts: set | None = None) -> float:
         found = offsets(reference, other)
